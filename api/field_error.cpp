@@ -1,0 +1,24 @@
+#include "api/field_error.h"
+
+namespace skyfarm::api {
+namespace {
+std::string join(const std::vector<FieldError>& errors) {
+  std::string s;
+  for (const auto& e : errors) {
+    if (!s.empty()) s += '\n';
+    s += e.message();
+  }
+  return s;
+}
+}  // namespace
+
+std::string FieldError::message() const {
+  std::string m = (path.empty() ? std::string("(request)") : path) + ": " + rule;
+  if (!value.empty()) m += ", got " + value;
+  return m;
+}
+
+ValidationError::ValidationError(std::vector<FieldError> errors)
+    : std::runtime_error(join(errors)), errors_(std::move(errors)) {}
+
+}  // namespace skyfarm::api

@@ -1,0 +1,33 @@
+# Embeds the physical tables of data/ into the binaries, so that a program runs
+# from any directory.  Each file becomes a byte array; embedded_file("name.csv")
+# (common/data/embedded_files.h) returns its text.
+set(SKYFARM_DATA_FILES
+  cie1931_2deg_xyz.csv
+  cie_d65.csv
+  solar_am0.csv
+  ozone_cross_section.csv
+  ozone_profile.csv
+  us_standard_atmosphere_1976.csv
+  us_std_atm_1976_layers.csv
+  elterman_1968_aerosol.csv
+  rayleigh_bucholtz1995.csv
+  cloud_mie_phase_water_reff10um.csv
+)
+
+function(skyfarm_embed_data OUT_VAR)
+  set(inputs "")
+  foreach(f IN LISTS SKYFARM_DATA_FILES)
+    list(APPEND inputs "${PROJECT_SOURCE_DIR}/data/${f}")
+  endforeach()
+  set(out "${PROJECT_BINARY_DIR}/generated/embedded_data.cpp")
+  string(REPLACE ";" "|" files_arg "${SKYFARM_DATA_FILES}")
+  add_custom_command(
+    OUTPUT "${out}"
+    COMMAND ${CMAKE_COMMAND} -DDATA_DIR=${PROJECT_SOURCE_DIR}/data
+            "-DFILES=${files_arg}" -DOUT=${out}
+            -P ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    DEPENDS ${inputs} ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    COMMENT "Embedding data tables"
+    VERBATIM)
+  set(${OUT_VAR} "${out}" PARENT_SCOPE)
+endfunction()

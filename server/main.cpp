@@ -1,0 +1,2 @@
+#include <iostream>
+int main() { std::cout << "skyfarm-server (skeleton)\n"; return 0; }

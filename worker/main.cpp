@@ -1,0 +1,2 @@
+#include <iostream>
+int main() { std::cout << "skyfarm-worker (skeleton)\n"; return 0; }
