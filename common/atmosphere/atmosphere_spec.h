@@ -19,7 +19,7 @@ struct ExponentialDensity {
   double scale_height_m = 8000.0;
 };
 // {"type": "table", "altitude_m": [...], "values": [...]}: piecewise linear,
-// held constant beyond the last altitude.
+// zero below the first and above the last altitude.
 struct TableDensity {
   std::vector<double> altitude_m;
   std::vector<double> values;
