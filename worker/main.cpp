@@ -1,2 +1,99 @@
+// skyfarm-worker: the worker side of skyfarm.
+//   skyfarm-worker info REQUEST.json [--json]   the request's sun and optical depths
+//   skyfarm-worker --help | --version
+// `render`, `probe` and `bench` arrive with the path tracer (issue 3), the farm
+// worker loop (`--connect`) with the server (issue 4).
+#include <cstdio>
+#include <fstream>
 #include <iostream>
-int main() { std::cout << "skyfarm-worker (skeleton)\n"; return 0; }
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "api/field_error.h"
+#include "api/render_request.h"
+#include "worker/sky_report.h"
+
+namespace {
+
+constexpr const char* kUsage =
+    "usage: skyfarm-worker <command> [options]\n"
+    "\n"
+    "commands:\n"
+    "  info REQUEST.json [--json]   sun position and optical depths of a render request\n"
+    "                                (REQUEST.json may be '-' for standard input)\n"
+    "\n"
+    "options:\n"
+    "  --help      this text\n"
+    "  --version   the skyfarm version\n";
+
+bool read_input(const std::string& path, std::string* text, std::string* error) {
+  std::ostringstream buffer;
+  if (path == "-") {
+    buffer << std::cin.rdbuf();
+  } else {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) {
+      *error = "cannot open " + path;
+      return false;
+    }
+    buffer << in.rdbuf();
+  }
+  *text = buffer.str();
+  return true;
+}
+
+int run_info(const std::vector<std::string>& args) {
+  std::string path;
+  bool json = false;
+  for (const auto& a : args) {
+    if (a == "--json") {
+      json = true;
+    } else if (path.empty()) {
+      path = a;
+    } else {
+      std::cerr << "skyfarm-worker info: unexpected argument '" << a << "'\n" << kUsage;
+      return 2;
+    }
+  }
+  if (path.empty()) {
+    std::cerr << "skyfarm-worker info: a request file is required\n" << kUsage;
+    return 2;
+  }
+  std::string text, error;
+  if (!read_input(path, &text, &error)) {
+    std::cerr << "skyfarm-worker info: " << error << "\n";
+    return 1;
+  }
+  try {
+    const auto request = skyfarm::api::parse_render_request(text);
+    const auto report = skyfarm::sky_report(request);
+    std::cout << (json ? report.dump(2) + "\n" : skyfarm::format_sky_report(report));
+    return 0;
+  } catch (const skyfarm::api::ValidationError& e) {
+    std::cerr << path << ": invalid request\n" << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-worker info: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kUsage;
+    return args.empty() ? 2 : 0;
+  }
+  if (args[0] == "--version") {
+    std::cout << "skyfarm " << SKYFARM_VERSION << "\n";
+    return 0;
+  }
+  const std::string command = args[0];
+  args.erase(args.begin());
+  if (command == "info") return run_info(args);
+  std::cerr << "skyfarm-worker: unknown command '" << command << "'\n" << kUsage;
+  return 2;
+}

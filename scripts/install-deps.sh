@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian packages skyfarm builds and runs with, when missing.
+# Safe to run again: it only calls apt-get when something is not installed.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libopenexr-dev libimath-dev libglm-dev nlohmann-json3-dev libpng-dev
+  libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if ((${#missing[@]})); then
+  echo "skyfarm: installing ${missing[*]}"
+  sudo_cmd=()
+  [[ $(id -u) -ne 0 ]] && sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
