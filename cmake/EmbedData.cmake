@@ -12,6 +12,7 @@ set(SKYFARM_DATA_FILES
   elterman_1968_aerosol.csv
   rayleigh_bucholtz1995.csv
   cloud_mie_phase_water_reff10um.csv
+  spa_periodic_terms.csv spa_nutation_terms.csv
 )
 
 function(skyfarm_embed_data OUT_VAR)

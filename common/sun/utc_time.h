@@ -28,4 +28,22 @@ std::optional<UtcInstant> parse_iso8601(std::string_view text, std::string* erro
 // The calendar year (UTC) of an instant, for range checks.
 int utc_year(const UtcInstant& t);
 
+// The instant as a continuous decimal year (UTC): year + (time since 1 January
+// 00:00) / (length of that year), e.g. 2000-07-02T00:00Z -> 2000.5.
+double utc_decimal_year(const UtcInstant& t);
+
+// --- Proleptic Gregorian calendar arithmetic (H. Hinnant's algorithms) -------
+struct CivilDate {
+  std::int64_t year = 1970;
+  unsigned month = 1;  // [1, 12]
+  unsigned day = 1;    // [1, 31]
+};
+
+bool is_leap_year(std::int64_t year);
+// 28..31; 0 when `month` is not in [1, 12].
+unsigned last_day_of_month(std::int64_t year, unsigned month);
+// Days since 1970-01-01 (negative before) of a valid date, and its inverse.
+std::int64_t days_from_civil(std::int64_t year, unsigned month, unsigned day);
+CivilDate civil_from_days(std::int64_t days);
+
 }  // namespace skyfarm
