@@ -1,0 +1,77 @@
+// The render request (DESIGN §5.1): parsing with field-named validation errors
+// and the canonical form the farm hashes.  Field by field rules:
+// docs/request-schema.md.
+#pragma once
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+#include "api/field_error.h"
+#include "api/json_fields.h"
+#include "common/atmosphere/atmosphere_spec.h"
+#include "common/camera/camera_spec.h"
+#include "common/sun/sun_spec.h"
+#include "common/sun/utc_time.h"
+
+namespace skyfarm::api {
+
+// "spectral": the wavelength range rendered and how many batches it is cut into.
+struct SpectralSpec {
+  double min_nm = 360.0;
+  double max_nm = 830.0;
+  int batches = 4;
+};
+
+// "quality": when a render stops (whichever comes first).
+struct QualitySpec {
+  int samples_per_pixel = 64;
+  std::optional<double> target_relative_error;  // image relative RMS error
+  std::optional<double> time_limit_s;
+};
+
+// "output": what the result files carry.
+struct OutputSpec {
+  std::optional<double> exposure_ev;  // PNG exposure; none = automatic
+  bool spectral_channels = false;     // one EXR channel per wavelength batch
+  bool error_layer = false;           // relative standard error per pixel
+  bool half = true;                   // EXR half floats (else 32-bit floats)
+};
+
+// A validated render request, every default filled in.
+struct RenderRequest {
+  Location location;
+  std::optional<UtcInstant> time;
+  std::optional<std::string> time_text;  // "time" as the client wrote it
+  SunSpec sun;
+  CameraSpec camera;
+  AtmosphereSpec atmosphere;
+  SpectralSpec spectral;
+  QualitySpec quality;
+  Method method = Method::kPath;
+  OutputSpec output;
+  std::uint64_t seed = 1;
+  int priority = 50;
+};
+
+// Parses and validates a request body.  Throws ValidationError listing every
+// invalid field; no other exception escapes, whatever the input.
+RenderRequest parse_render_request(std::string_view json_text);
+RenderRequest parse_render_request(const nlohmann::json& body);
+inline RenderRequest parse_render_request(const std::string& json_text) {
+  return parse_render_request(std::string_view(json_text));
+}
+inline RenderRequest parse_render_request(const char* json_text) {
+  return parse_render_request(std::string_view(json_text));
+}
+
+// Every field with its default filled in and equivalent spellings unified
+// (docs/request-schema.md "Canonical form"): requests that mean the same give
+// the same to_canonical_json(r).dump(); parsing it gives the same request back.
+nlohmann::json to_canonical_json(const RenderRequest& request);
+// to_canonical_json(request).dump(): the text the farm hashes.
+std::string canonical_text(const RenderRequest& request);
+
+}  // namespace skyfarm::api

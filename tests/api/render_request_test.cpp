@@ -1,0 +1,593 @@
+// Tests of the render request (DESIGN §5.1): the examples in api/examples/, the
+// bad requests in api/examples/bad/ with their expected first error, defaults,
+// error collection, hostile bodies and the canonical form.
+#include "api/render_request.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace skyfarm::api {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kExamples = fs::path(SKYFARM_SOURCE_DIR) / "api" / "examples";
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The examples of one kind: probe*.json are probes, the others render requests.
+std::vector<fs::path> json_files(const fs::path& dir, bool probes) {
+  std::vector<fs::path> out;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.path().extension() != ".json" || name == "expected_errors.json") continue;
+    if (name.starts_with("probe") == probes) out.push_back(entry.path());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// The errors a body gets (empty when it parses).
+std::vector<FieldError> errors_of(std::string_view body) {
+  try {
+    parse_render_request(body);
+  } catch (const ValidationError& e) {
+    return e.errors();
+  }
+  return {};
+}
+
+std::vector<std::string> messages_of(std::string_view body) {
+  std::vector<std::string> out;
+  for (const auto& e : errors_of(body)) out.push_back(e.message());
+  return out;
+}
+
+// A valid body with one more top-level member.
+std::string with(const std::string& member) {
+  return R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180}, "camera": {"projection": "fisheye"})" +
+         (member.empty() ? std::string() : ", " + member) + "}";
+}
+
+// --- Examples -------------------------------------------------------------
+
+TEST(RenderRequestExamples, EveryGoodExampleParsesAndRoundTrips) {
+  const auto files = json_files(kExamples, false);
+  ASSERT_GE(files.size(), 5u);
+  for (const auto& file : files) {
+    SCOPED_TRACE(file.filename().string());
+    RenderRequest r;
+    ASSERT_NO_THROW(r = parse_render_request(read_text(file)));
+    const std::string canonical = canonical_text(r);
+    RenderRequest again;
+    ASSERT_NO_THROW(again = parse_render_request(canonical)) << canonical;
+    EXPECT_EQ(canonical_text(again), canonical);
+  }
+}
+
+TEST(RenderRequestExamples, EveryBadExampleGetsItsExpectedError) {
+  const auto expected = nlohmann::json::parse(read_text(kExamples / "bad" / "expected_errors.json"));
+  const auto files = json_files(kExamples / "bad", false);
+  ASSERT_GE(files.size(), 40u);
+  for (const auto& file : files) {
+    const std::string name = file.filename().string();
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(expected.contains(name)) << "no expected error listed";
+    const auto errors = errors_of(read_text(file));
+    ASSERT_EQ(errors.size(), 1u) << (errors.empty() ? "parsed" : ValidationError(errors).what());
+    EXPECT_EQ(errors[0].message(), expected[name].get<std::string>());
+  }
+}
+
+TEST(RenderRequestExamples, IndexListsOnlyExistingFiles) {
+  const auto expected = nlohmann::json::parse(read_text(kExamples / "bad" / "expected_errors.json"));
+  for (auto it = expected.begin(); it != expected.end(); ++it)
+    EXPECT_TRUE(fs::exists(kExamples / "bad" / it.key())) << it.key();
+}
+
+TEST(RenderRequestExamples, SunsetExampleReadsAsWritten) {
+  const RenderRequest r = parse_render_request(read_text(kExamples / "sunset_equirect.json"));
+  EXPECT_DOUBLE_EQ(r.location.latitude_deg, 42.44);
+  EXPECT_DOUBLE_EQ(r.location.longitude_deg, -76.48);
+  ASSERT_TRUE(r.time.has_value());
+  EXPECT_EQ(r.time->to_iso8601(), "2013-05-28T00:30:00Z");
+  EXPECT_EQ(r.time_text, "2013-05-27T20:30:00-04:00");
+  EXPECT_EQ(r.camera.projection, Projection::kEquirectangular);
+  EXPECT_EQ(r.camera.width, 2048);
+  EXPECT_EQ(r.camera.height, 1024);
+  ASSERT_TRUE(r.atmosphere.aerosol.has_value());
+  EXPECT_DOUBLE_EQ(r.atmosphere.aerosol->optical_depth_550, 0.15);
+  EXPECT_EQ(r.spectral.batches, 8);
+  EXPECT_EQ(r.quality.target_relative_error, 0.01);
+  EXPECT_EQ(r.quality.time_limit_s, 600.0);
+  EXPECT_FALSE(r.output.exposure_ev.has_value());
+  EXPECT_TRUE(r.output.spectral_channels);
+  EXPECT_FALSE(r.output.half);
+  EXPECT_EQ(r.seed, 7u);
+  EXPECT_EQ(r.priority, 60);
+}
+
+TEST(RenderRequestExamples, CustomAtmosphereExampleHasBothConstituents) {
+  const RenderRequest r = parse_render_request(read_text(kExamples / "custom_atmosphere.json"));
+  const auto& a = r.atmosphere;
+  EXPECT_EQ(a.preset, AtmospherePreset::kCustom);
+  EXPECT_FALSE(a.aerosol.has_value());
+  ASSERT_EQ(a.constituents.size(), 2u);
+  EXPECT_EQ(a.constituents[0].name, "air");
+  EXPECT_TRUE(std::holds_alternative<ExponentialDensity>(a.constituents[0].density));
+  EXPECT_TRUE(std::holds_alternative<RayleighPhaseSpec>(a.constituents[0].phase));
+  EXPECT_EQ(a.constituents[1].name, "ozone");
+  const auto& layers = std::get<LayersDensity>(a.constituents[1].density).layers;
+  ASSERT_EQ(layers.size(), 2u);
+  EXPECT_DOUBLE_EQ(layers[0].width_m, 25000.0);
+  EXPECT_DOUBLE_EQ(layers[1].constant_term, 8.0 / 3.0);
+  EXPECT_TRUE(a.constituents[1].scattering_per_m.wavelengths_nm.empty());
+  EXPECT_EQ(a.constituents[1].absorption_per_m.values.size(), 7u);
+  EXPECT_TRUE(std::holds_alternative<SpectralTable>(a.ground_albedo));
+  EXPECT_EQ(r.method, Method::kLut);
+  EXPECT_EQ(r.camera.height, 512);  // derived from width 1024 at 2:1
+}
+
+// --- Defaults -------------------------------------------------------------
+
+TEST(RenderRequestDefaults, MinimalRequestGetsEveryDefault) {
+  const RenderRequest r = parse_render_request(with(""));
+  EXPECT_EQ(r.location.latitude_deg, 0.0);
+  EXPECT_EQ(r.location.longitude_deg, 0.0);
+  EXPECT_EQ(r.location.altitude_m, 0.0);
+  EXPECT_FALSE(r.time.has_value());
+  EXPECT_FALSE(r.time_text.has_value());
+  EXPECT_EQ(r.sun.zenith_deg, 30.0);
+  EXPECT_EQ(r.sun.azimuth_deg, 180.0);
+  EXPECT_DOUBLE_EQ(r.sun.angular_radius_deg, 0.2666);
+  EXPECT_FALSE(r.sun.irradiance.has_value());
+  EXPECT_EQ(r.camera.projection, Projection::kFisheye);
+  EXPECT_EQ(r.camera.width, 512);
+  EXPECT_EQ(r.camera.height, 512);
+  EXPECT_EQ(r.camera.fov_deg, 180.0);
+  EXPECT_EQ(r.camera.yaw_deg, 0.0);
+  EXPECT_EQ(r.atmosphere.preset, AtmospherePreset::kEarth);
+  EXPECT_EQ(r.atmosphere.ozone_du, 300.0);
+  ASSERT_TRUE(r.atmosphere.aerosol.has_value());
+  EXPECT_EQ(r.atmosphere.aerosol->optical_depth_550, 0.1);
+  EXPECT_EQ(r.atmosphere.aerosol->angstrom_exponent, 1.3);
+  EXPECT_EQ(r.atmosphere.aerosol->asymmetry, 0.7);
+  EXPECT_EQ(r.atmosphere.aerosol->single_scattering_albedo, 0.9);
+  EXPECT_EQ(r.atmosphere.aerosol->phase, AerosolPhase::kHenyeyGreenstein);
+  EXPECT_EQ(std::get<double>(r.atmosphere.ground_albedo), 0.3);
+  EXPECT_EQ(r.atmosphere.planet_radius_m, 6371000.0);
+  EXPECT_EQ(r.atmosphere.top_altitude_m, 100000.0);
+  EXPECT_EQ(r.spectral.min_nm, 360.0);
+  EXPECT_EQ(r.spectral.max_nm, 830.0);
+  EXPECT_EQ(r.spectral.batches, 4);
+  EXPECT_EQ(r.quality.samples_per_pixel, 64);
+  EXPECT_FALSE(r.quality.target_relative_error.has_value());
+  EXPECT_FALSE(r.quality.time_limit_s.has_value());
+  EXPECT_EQ(r.method, Method::kPath);
+  EXPECT_FALSE(r.output.exposure_ev.has_value());
+  EXPECT_FALSE(r.output.spectral_channels);
+  EXPECT_FALSE(r.output.error_layer);
+  EXPECT_TRUE(r.output.half);
+  EXPECT_EQ(r.seed, 1u);
+  EXPECT_EQ(r.priority, 50);
+}
+
+TEST(RenderRequestDefaults, SizeAndFieldOfViewFollowTheProjection) {
+  auto camera = [](const std::string& c) {
+    return parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 0}, "camera": )" + c + "}").camera;
+  };
+  auto eq = camera(R"({"projection": "equirectangular"})");
+  EXPECT_EQ(eq.width, 1024);
+  EXPECT_EQ(eq.height, 512);
+  EXPECT_EQ(eq.fov_deg, 360.0);
+  auto persp = camera(R"({"projection": "perspective"})");
+  EXPECT_EQ(persp.width, 960);
+  EXPECT_EQ(persp.height, 540);
+  EXPECT_EQ(persp.fov_deg, 60.0);
+  // A lone side keeps the default aspect.
+  auto wide = camera(R"({"projection": "perspective", "width": 1920})");
+  EXPECT_EQ(wide.height, 1080);
+  auto tall = camera(R"({"projection": "equirectangular", "height": 1000})");
+  EXPECT_EQ(tall.width, 2000);
+  auto odd = camera(R"({"projection": "equirectangular", "width": 1})");
+  EXPECT_EQ(odd.height, 1);
+  // Equirectangular ignores fov_deg (but it must still be sensible).
+  EXPECT_EQ(camera(R"({"projection": "equirectangular", "fov_deg": 60})").fov_deg, 360.0);
+  EXPECT_EQ(camera(R"({"projection": "fisheye", "fov_deg": 220})").fov_deg, 220.0);
+  // The largest image allowed.
+  auto big = camera(R"({"projection": "equirectangular", "width": 16384, "height": 8192})");
+  EXPECT_EQ(big.width * static_cast<long long>(big.height), 16384LL * 8192);
+}
+
+TEST(RenderRequestDefaults, EarthClearHasNoAerosolUnlessGiven) {
+  auto atmosphere = [](const std::string& a) {
+    return parse_render_request(with(R"("atmosphere": )" + a)).atmosphere;
+  };
+  EXPECT_FALSE(atmosphere(R"({"preset": "earth_clear"})").aerosol.has_value());
+  EXPECT_TRUE(atmosphere(R"({"preset": "earth_clear", "aerosol": {}})").aerosol.has_value());
+  EXPECT_FALSE(atmosphere(R"({"preset": "earth", "aerosol": null})").aerosol.has_value());
+  const auto a = atmosphere(R"({"aerosol": {"optical_depth_550": 0.3, "phase": "cornette_shanks"}})");
+  ASSERT_TRUE(a.aerosol.has_value());
+  EXPECT_EQ(a.aerosol->optical_depth_550, 0.3);
+  EXPECT_EQ(a.aerosol->asymmetry, 0.7);
+  EXPECT_EQ(a.aerosol->phase, AerosolPhase::kCornetteShanks);
+}
+
+TEST(RenderRequestDefaults, NullMeansAbsentForFieldsWithoutADefaultValue) {
+  const RenderRequest r = parse_render_request(with(
+      R"("time": "2013-05-27T09:30:00-04:00", "quality": {"target_relative_error": null, "time_limit_s": null},
+         "output": {"exposure_ev": null})"));
+  EXPECT_FALSE(r.quality.target_relative_error.has_value());
+  EXPECT_FALSE(r.output.exposure_ev.has_value());
+  EXPECT_TRUE(r.time.has_value());
+  // "time": null with sun angles is a request without a time.
+  EXPECT_FALSE(parse_render_request(with(R"("time": null)")).time.has_value());
+}
+
+// --- Errors ---------------------------------------------------------------
+
+TEST(RenderRequestErrors, CollectsEveryInvalidField) {
+  const auto m = messages_of(R"({
+    "location": {"latitude_deg": 91, "longitude_deg": "west"},
+    "sun": {"zenith_deg": 30, "azimuth_deg": 180},
+    "camera": {"projection": "fisheye", "width": -3, "lens": "wide"},
+    "spectral": {"batches": 65},
+    "seed": -1, "priority": 101})");
+  const std::vector<std::string> expected = {
+      "location.latitude_deg: must be a number in [-90, 90], got 91",
+      "location.longitude_deg: must be a number, got \"west\"",
+      "camera.lens: unknown field (allowed: projection, width, height, yaw_deg, pitch_deg, roll_deg, fov_deg)",
+      "camera.width: must be an integer in [1, 16384], got -3",
+      "spectral.batches: must be an integer in [1, 64], got 65",
+      "seed: must be an integer in [0, 18446744073709551615], got -1",
+      "priority: must be an integer in [0, 100], got 101",
+  };
+  EXPECT_EQ(m, expected);
+}
+
+TEST(RenderRequestErrors, WhatListsEveryErrorOnItsOwnLine) {
+  try {
+    parse_render_request(R"({"camera": {"projection": "fisheye"}, "seed": "x", "priority": "y"})");
+    FAIL() << "accepted";
+  } catch (const ValidationError& e) {
+    EXPECT_STREQ(e.what(),
+                 "time: required unless sun.zenith_deg and sun.azimuth_deg are given\n"
+                 "seed: must be an integer, got \"x\"\n"
+                 "priority: must be an integer, got \"y\"");
+  }
+}
+
+TEST(RenderRequestErrors, UnknownFieldsAreRejectedAtEveryLevel) {
+  for (const auto& [body, message] : std::vector<std::pair<std::string, std::string>>{
+           {with(R"("colour": 1)"),
+            "colour: unknown field (allowed: location, time, sun, camera, atmosphere, spectral, quality, method, "
+            "output, seed, priority)"},
+           {with(R"("quality": {"spp": 4})"),
+            "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s)"},
+           {with(R"("output": {"png": true})"),
+            "output.png: unknown field (allowed: exposure_ev, spectral_channels, error_layer, half)"},
+           {with(R"("spectral": {"step_nm": 5})"), "spectral.step_nm: unknown field (allowed: min_nm, max_nm, batches)"},
+           {with(R"("atmosphere": {"aerosol": {"type": "urban"}})"),
+            "atmosphere.aerosol.type: unknown field (allowed: optical_depth_550, angstrom_exponent, asymmetry, "
+            "single_scattering_albedo, phase)"},
+           {R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180, "elevation_deg": 60}, "camera": {"projection": "fisheye"}})",
+            "sun.elevation_deg: unknown field (allowed: zenith_deg, azimuth_deg, angular_radius_deg, irradiance)"},
+       }) {
+    EXPECT_EQ(messages_of(body), std::vector<std::string>{message}) << body;
+  }
+}
+
+TEST(RenderRequestErrors, WrongTypesNameTheExpectedType) {
+  EXPECT_EQ(messages_of(with(R"("location": {"latitude_deg": "north"})")),
+            std::vector<std::string>{"location.latitude_deg: must be a number, got \"north\""});
+  EXPECT_EQ(messages_of(with(R"("location": {"latitude_deg": true})")),
+            std::vector<std::string>{"location.latitude_deg: must be a number, got true"});
+  EXPECT_EQ(messages_of(with(R"("location": {"latitude_deg": null})")),
+            std::vector<std::string>{"location.latitude_deg: must be a number, got null"});
+  EXPECT_EQ(messages_of(with(R"("location": {"latitude_deg": [1, 2]})")),
+            std::vector<std::string>{"location.latitude_deg: must be a number, got [1,2]"});
+  EXPECT_EQ(messages_of(with(R"("output": {"half": "yes"})")),
+            std::vector<std::string>{"output.half: must be a boolean, got \"yes\""});
+  EXPECT_EQ(messages_of(with(R"("method": 1)")), std::vector<std::string>{"method: must be one of path, lut, got 1"});
+  EXPECT_EQ(messages_of(with(R"("atmosphere": null)")),
+            std::vector<std::string>{"atmosphere: must be an object, got null"});
+}
+
+TEST(RenderRequestErrors, IntegersMayBeWrittenWithAZeroFraction) {
+  const RenderRequest r = parse_render_request(
+      R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180}, "camera": {"projection": "fisheye", "width": 3.0, "height": 2e2},
+          "seed": 1e3, "priority": 7.0})");
+  EXPECT_EQ(r.camera.width, 3);
+  EXPECT_EQ(r.camera.height, 200);
+  EXPECT_EQ(r.seed, 1000u);
+  EXPECT_EQ(r.priority, 7);
+  EXPECT_EQ(messages_of(with(R"("priority": 3.5)")), std::vector<std::string>{"priority: must be an integer, got 3.5"});
+}
+
+TEST(RenderRequestErrors, SunAnglesBothOrNeither) {
+  const std::string camera = R"("camera": {"projection": "fisheye"})";
+  const std::string time = R"("time": "2013-05-27T09:30:00-04:00")";
+  // Both, or neither with a time: fine.
+  EXPECT_TRUE(messages_of("{" + camera + R"(, "sun": {"zenith_deg": 0, "azimuth_deg": 360}})").empty());
+  EXPECT_TRUE(messages_of("{" + camera + ", " + time + R"(, "sun": {"angular_radius_deg": 0}})").empty());
+  EXPECT_TRUE(messages_of("{" + camera + ", " + time + R"(, "sun": {"zenith_deg": null, "azimuth_deg": null}})").empty());
+  // One alone: one error, with or without a time.
+  EXPECT_EQ(messages_of("{" + camera + ", " + time + R"(, "sun": {"zenith_deg": 10}})"),
+            std::vector<std::string>{"sun.azimuth_deg: required when sun.zenith_deg is given"});
+  EXPECT_EQ(messages_of("{" + camera + R"(, "sun": {"azimuth_deg": 10}})"),
+            std::vector<std::string>{"sun.zenith_deg: required when sun.azimuth_deg is given"});
+  // Neither and no time: "now" is never a default.
+  EXPECT_EQ(messages_of("{" + camera + R"(, "sun": {}})"),
+            std::vector<std::string>{"time: required unless sun.zenith_deg and sun.azimuth_deg are given"});
+  EXPECT_EQ(messages_of("{" + camera + R"(, "time": null})"),
+            std::vector<std::string>{"time: required unless sun.zenith_deg and sun.azimuth_deg are given"});
+  // Angles given with a time: both kept (the angles replace the computed position).
+  const RenderRequest r = parse_render_request("{" + camera + ", " + time + R"(, "sun": {"zenith_deg": 10, "azimuth_deg": 20}})");
+  EXPECT_TRUE(r.time.has_value());
+  EXPECT_EQ(r.sun.zenith_deg, 10.0);
+}
+
+TEST(RenderRequestErrors, TimeRules) {
+  const RenderRequest r = parse_render_request(with(R"("time": "2013-05-27T09:30:00-04:00")"));
+  ASSERT_TRUE(r.time.has_value());
+  EXPECT_EQ(r.time->to_iso8601(), "2013-05-27T13:30:00Z");
+  EXPECT_TRUE(messages_of(with(R"("time": "1800-01-01T00:00:00Z")")).empty());
+  EXPECT_TRUE(messages_of(with(R"("time": "2200-12-31T23:59:59Z")")).empty());
+  EXPECT_EQ(messages_of(with(R"("time": "2201-01-01T00:00:00Z")")),
+            std::vector<std::string>{"time: year must be in [1800, 2200], got \"2201-01-01T00:00:00Z\""});
+  const auto m = messages_of(with(R"("time": "2013-02-29T00:00:00Z")"));
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_TRUE(m[0].starts_with("time: must be ISO 8601 with a UTC offset (")) << m[0];
+}
+
+TEST(RenderRequestErrors, PresetRestrictions) {
+  const std::string air = R"({"name": "air", "density": {"type": "exponential", "scale_height_m": 8000},
+      "scattering_per_m": {"wavelengths_nm": [550], "values": [1.3e-5]}, "phase": {"type": "rayleigh"}})";
+  EXPECT_TRUE(messages_of(with(R"("atmosphere": {"preset": "custom", "constituents": [)" + air + "]}")).empty());
+  EXPECT_EQ(messages_of(with(R"("atmosphere": {"preset": "custom", "ozone_du": 300, "aerosol": null, "constituents": [)" + air + "]}")),
+            (std::vector<std::string>{"atmosphere.ozone_du: not allowed with preset custom, got 300",
+                                      "atmosphere.aerosol: not allowed with preset custom, got null"}));
+  EXPECT_EQ(messages_of(with(R"("atmosphere": {"preset": "earth_clear", "constituents": [)" + air + "]}")),
+            std::vector<std::string>{"atmosphere.constituents: only allowed with preset custom"});
+  // With an unknown preset the other fields are still checked, without cascading.
+  EXPECT_EQ(messages_of(with(R"("atmosphere": {"preset": "venus", "ozone_du": -1})")),
+            (std::vector<std::string>{"atmosphere.preset: must be one of earth, earth_clear, custom, got \"venus\"",
+                                      "atmosphere.ozone_du: must be a number in [0, 1000], got -1"}));
+}
+
+TEST(RenderRequestErrors, OneEntryTablesAreConstantsExceptTheSunSpectrum) {
+  const RenderRequest r = parse_render_request(with(
+      R"("atmosphere": {"ground_albedo": {"wavelengths_nm": [550], "values": [1]}})"));
+  EXPECT_EQ(std::get<SpectralTable>(r.atmosphere.ground_albedo).values.size(), 1u);
+  // The sun's table is 0 outside its range: one entry would be a single line.
+  EXPECT_EQ(messages_of(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180, "irradiance": {"wavelengths_nm": [550], "values": [1.8]}},
+                            "camera": {"projection": "fisheye"}})"),
+            std::vector<std::string>{"sun.irradiance.wavelengths_nm: must have 2 to 100000 entries, got 1 entry"});
+}
+
+// --- Hostile bodies -------------------------------------------------------
+
+TEST(RenderRequestHostile, DepthBombIsOneClearError) {
+  for (std::size_t depth : {33u, 100u, 100000u}) {
+    const std::string bomb = std::string(depth, '[') + std::string(depth, ']');
+    EXPECT_EQ(messages_of(bomb), std::vector<std::string>{"(request): JSON nested deeper than 32 levels"});
+    EXPECT_EQ(messages_of(with(R"("camera2": )" + bomb)),
+              std::vector<std::string>{"(request): JSON nested deeper than 32 levels"});
+  }
+  // An unterminated bomb too (the depth is seen before the end of input).
+  EXPECT_EQ(messages_of(std::string(1000000, '[')), std::vector<std::string>{"(request): JSON nested deeper than 32 levels"});
+  // 32 levels are read normally (and this one is an unknown field).
+  const std::string deep = R"({"x": )" + std::string(31, '[') + std::string(31, ']') + "}";
+  const auto m = messages_of(deep);
+  ASSERT_FALSE(m.empty());
+  EXPECT_TRUE(m[0].starts_with("x: unknown field")) << m[0];
+}
+
+TEST(RenderRequestHostile, BodyThatIsNotAnObject) {
+  EXPECT_EQ(messages_of("[]"), std::vector<std::string>{"(request): must be a JSON object, got []"});
+  EXPECT_EQ(messages_of("3"), std::vector<std::string>{"(request): must be a JSON object, got 3"});
+  EXPECT_EQ(messages_of("null"), std::vector<std::string>{"(request): must be a JSON object, got null"});
+  EXPECT_EQ(messages_of("\"render\""), std::vector<std::string>{"(request): must be a JSON object, got \"render\""});
+  // The json overload has the same rule.
+  try {
+    parse_render_request(nlohmann::json::array({1, 2}));
+    FAIL() << "accepted";
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.errors().at(0).message(), "(request): must be a JSON object, got [1,2]");
+  }
+}
+
+TEST(RenderRequestHostile, MalformedJsonIsOneErrorWithEmptyPath) {
+  for (const std::string body : {"", "{", "{\"camera\": }", "{} {}", "{'a': 1}", "{\"a\": NaN}", "{\"a\": Infinity}",
+                                 "\xff\xfe", "{\"a\": \"\xc3\x28\"}", "{\"a\": 01}", "/* c */ {}"}) {
+    const auto errors = errors_of(body);
+    ASSERT_EQ(errors.size(), 1u) << body;
+    EXPECT_EQ(errors[0].path, "");
+    EXPECT_TRUE(errors[0].rule.starts_with("malformed JSON: parse error at line ")) << errors[0].rule;
+  }
+}
+
+TEST(RenderRequestHostile, GiantAndNonFiniteNumbers) {
+  EXPECT_EQ(parse_render_request(with(R"("seed": 18446744073709551615)")).seed, 18446744073709551615u);
+  EXPECT_EQ(parse_render_request(with(R"("seed": 0)")).seed, 0u);
+  EXPECT_EQ(messages_of(with(R"("seed": 18446744073709551616)")),
+            std::vector<std::string>{"seed: must be an integer in [0, 18446744073709551615], got 1.8446744073709552e+19"});
+  EXPECT_EQ(messages_of(with(R"("seed": -9223372036854775809)")),
+            std::vector<std::string>{"seed: must be an integer in [0, 18446744073709551615], got -9.223372036854776e+18"});
+  EXPECT_EQ(messages_of(with(R"("priority": 99999999999999999999999999999)")),
+            std::vector<std::string>{"priority: must be an integer in [0, 100], got 1e+29"});
+  EXPECT_EQ(messages_of(with(R"("priority": 18446744073709551615)")),
+            std::vector<std::string>{"priority: must be an integer in [0, 100], got 18446744073709551615"});
+  EXPECT_EQ(messages_of(with(R"("priority": -9223372036854775808)")),
+            std::vector<std::string>{"priority: must be an integer in [0, 100], got -9223372036854775808"});
+  EXPECT_EQ(messages_of(with(R"("priority": 1e400)")),
+            std::vector<std::string>{"priority: must be a finite number, got 1e400"});
+  // Such a number stops the parse: it is the only error listed.
+  EXPECT_EQ(messages_of(R"({"camera": 1, "sun": {"irradiance": {"wavelengths_nm": [500], "values": [-1e999]}}})"),
+            std::vector<std::string>{"sun.irradiance.values[0]: must be a finite number, got -1e999"});
+  EXPECT_EQ(messages_of(with(R"("location": {"altitude_m": -1e999})")),
+            std::vector<std::string>{"location.altitude_m: must be a finite number, got -1e999"});
+  EXPECT_EQ(messages_of(with(R"("location": {"altitude_m": 1e300})")),
+            std::vector<std::string>{"location.altitude_m: must be a number in [0, 100000000], got 1e+300"});
+  EXPECT_EQ(messages_of(with(R"("location": {"latitude_deg": 1e-400})")), std::vector<std::string>{});
+  // Through the json overload a NaN can arrive; it is named as such.
+  nlohmann::json body = nlohmann::json::parse(with(""));
+  body["location"]["latitude_deg"] = std::nan("");
+  try {
+    parse_render_request(body);
+    FAIL() << "accepted";
+  } catch (const ValidationError& e) {
+    EXPECT_EQ(e.errors().at(0).message(), "location.latitude_deg: must be a finite number, got NaN");
+  }
+}
+
+TEST(RenderRequestHostile, DuplicateKeysAreErrors) {
+  EXPECT_EQ(messages_of(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180, "zenith_deg": 40}, "camera": {"projection": "fisheye"}})"),
+            std::vector<std::string>{"sun.zenith_deg: duplicate field"});
+}
+
+TEST(RenderRequestHostile, HugeValuesAreQuotedShortly) {
+  const std::string big(100000, 'x');
+  const auto m = messages_of(with(R"("method": ")" + big + "\""));
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(m[0].size(), 200u);
+  const auto k = messages_of(with("\"" + big + "\": 1"));
+  ASSERT_EQ(k.size(), 1u);
+  EXPECT_LT(k[0].size(), 400u);
+  const auto unterminated = messages_of(R"({"camera": ")" + big);
+  ASSERT_EQ(unterminated.size(), 1u);
+  EXPECT_LT(unterminated[0].size(), 400u);
+  std::string array = "[";
+  for (int i = 0; i < 100000; ++i) array += (i ? ",1" : "1");
+  array += "]";
+  const auto a = messages_of(with(R"("seed": )" + array));
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_LT(a[0].size(), 200u);
+}
+
+TEST(RenderRequestHostile, MessagesAreSafeToEmbedInJson) {
+  // Through the json overload keys and strings may hold anything.
+  nlohmann::json body = nlohmann::json::parse(with(""));
+  body["a\nb\xff"] = 1;
+  body["time"] = "2013-05-27T09:30:00+01:00\n\xff";
+  try {
+    parse_render_request(body);
+    FAIL() << "accepted";
+  } catch (const ValidationError& e) {
+    const std::string what = e.what();
+    ASSERT_EQ(e.errors().size(), 2u) << what;
+    EXPECT_EQ(std::count(what.begin(), what.end(), '\n'), 1);  // the line break between the two errors
+    EXPECT_NO_THROW((void)nlohmann::json(what).dump());
+  }
+}
+
+TEST(RenderRequestHostile, ErrorListIsCapped) {
+  std::string body = R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180}, "camera": {"projection": "fisheye"})";
+  for (int i = 0; i < 1000; ++i) body += ", \"x" + std::to_string(i) + "\": 1";
+  body += "}";
+  const auto errors = errors_of(body);
+  ASSERT_EQ(errors.size(), kMaxErrors + 1);
+  EXPECT_EQ(errors.back().message(), "(request): too many errors; only the first 100 are listed");
+}
+
+TEST(RenderRequestHostile, MutatedExamplesNeverThrowAnythingElse) {
+  std::mt19937 rng(12345);
+  const auto files = json_files(kExamples, false);
+  const std::string alphabet = "{}[]\",:0123456789.eE+-aeflnrstux \\";
+  int accepted = 0, rejected = 0;
+  for (int i = 0; i < 3000; ++i) {
+    std::string text = read_text(files[i % files.size()]);
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int k = 0; k < edits && !text.empty(); ++k) {
+      const std::size_t at = rng() % text.size();
+      switch (rng() % 4) {
+        case 0: text[at] = alphabet[rng() % alphabet.size()]; break;
+        case 1: text.erase(at, 1 + rng() % 8); break;
+        case 2: text.insert(at, 1, alphabet[rng() % alphabet.size()]); break;
+        default: text.resize(at); break;
+      }
+    }
+    try {
+      const RenderRequest r = parse_render_request(text);
+      EXPECT_EQ(canonical_text(parse_render_request(canonical_text(r))), canonical_text(r));
+      ++accepted;
+    } catch (const ValidationError& e) {
+      EXPECT_FALSE(e.errors().empty());
+      ++rejected;
+    } catch (...) {
+      ADD_FAILURE() << "non-ValidationError exception for: " << text;
+    }
+  }
+  EXPECT_GT(rejected, 0);
+  EXPECT_GT(accepted + rejected, 0);
+}
+
+// --- Canonical form -------------------------------------------------------
+
+TEST(RenderRequestCanonical, SameMeaningSameText) {
+  auto text = [](const std::string& body) { return canonical_text(parse_render_request(body)); };
+  // Defaults written out or left out, key order, 42 vs 42.0, the UTC offset.
+  EXPECT_EQ(text(R"({"time": "2013-05-27T09:30:00-04:00", "camera": {"projection": "fisheye"}})"),
+            text(R"({"seed": 1, "camera": {"width": 512.0, "projection": "fisheye", "fov_deg": 180},
+                     "location": {"latitude_deg": 0.0, "longitude_deg": -0.0}, "time": "2013-05-27T13:30Z",
+                     "method": "path", "priority": 50, "output": {"exposure_ev": null, "half": true},
+                     "atmosphere": {"preset": "earth", "ozone_du": 300, "aerosol": {"optical_depth_550": 0.1}},
+                     "spectral": {"min_nm": 360, "max_nm": 830, "batches": 4},
+                     "quality": {"samples_per_pixel": 64, "target_relative_error": null}})"));
+  // earth_clear is earth without aerosols.
+  EXPECT_EQ(text(with(R"("atmosphere": {"preset": "earth_clear"})")),
+            text(with(R"("atmosphere": {"preset": "earth", "aerosol": null})")));
+  // Angles with the same meaning; equirectangular ignores fov_deg.
+  EXPECT_EQ(text(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 360}, "camera": {"projection": "equirectangular", "yaw_deg": -90, "roll_deg": -180, "fov_deg": 10}})"),
+            text(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 0}, "camera": {"projection": "equirectangular", "yaw_deg": 270, "roll_deg": 180}})"));
+  // Different meaning, different text.
+  EXPECT_NE(text(with(R"("seed": 1)")), text(with(R"("seed": 2)")));
+  EXPECT_NE(text(with(R"("atmosphere": {"preset": "earth"})")), text(with(R"("atmosphere": {"preset": "earth_clear"})")));
+}
+
+TEST(RenderRequestCanonical, EveryFieldIsPresent) {
+  const nlohmann::json c = to_canonical_json(parse_render_request(with("")));
+  for (const char* key : {"location", "time", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output",
+                          "seed", "priority"})
+    EXPECT_TRUE(c.contains(key)) << key;
+  EXPECT_TRUE(c["time"].is_null());
+  EXPECT_EQ(c["camera"]["width"], 512);
+  EXPECT_TRUE(c["camera"]["width"].is_number_integer());
+  EXPECT_EQ(c["atmosphere"]["preset"], "earth");
+  EXPECT_EQ(c["atmosphere"]["aerosol"]["phase"], "henyey_greenstein");
+  EXPECT_TRUE(c["quality"]["time_limit_s"].is_null());
+  EXPECT_EQ(c["output"]["half"], true);
+  EXPECT_EQ(c["seed"], 1u);
+  EXPECT_EQ(c["sun"]["angular_radius_deg"], 0.2666);
+  EXPECT_TRUE(c["sun"]["irradiance"].is_null());
+}
+
+TEST(RenderRequestCanonical, CustomAtmosphereKeepsOnlyItsFields) {
+  const nlohmann::json c = to_canonical_json(parse_render_request(read_text(kExamples / "custom_atmosphere.json")));
+  const auto& a = c["atmosphere"];
+  EXPECT_EQ(a["preset"], "custom");
+  EXPECT_FALSE(a.contains("ozone_du"));
+  EXPECT_FALSE(a.contains("aerosol"));
+  ASSERT_EQ(a["constituents"].size(), 2u);
+  EXPECT_TRUE(a["constituents"][0]["absorption_per_m"].is_null());
+  EXPECT_TRUE(a["constituents"][1]["scattering_per_m"].is_null());
+  EXPECT_TRUE(a["constituents"][1]["phase"].is_null());  // no scattering: no phase
+  EXPECT_EQ(a["constituents"][1]["density"]["layers"].size(), 2u);
+}
+
+}  // namespace
+}  // namespace skyfarm::api
