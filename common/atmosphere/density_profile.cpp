@@ -5,17 +5,11 @@
 #include <stdexcept>
 
 #include "common/atmosphere/us76.h"
+#include "common/core/overloaded.h"
 #include "common/core/integrate.h"
 
 namespace skyfarm {
 namespace {
-
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
 
 // --- Bruneton layers (Bruneton 2017, functions.glsl GetLayerDensity /
 // GetProfileDensity): layer i spans [bottom_i, bottom_i + width_i); the last

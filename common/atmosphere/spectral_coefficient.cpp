@@ -7,16 +7,10 @@
 #include "common/atmosphere/ozone.h"
 #include "common/atmosphere/rayleigh.h"
 #include "common/atmosphere/us76.h"
+#include "common/core/overloaded.h"
 
 namespace skyfarm {
 namespace {
-
-template <class... F>
-struct Overloaded : F... {
-  using F::operator()...;
-};
-template <class... F>
-Overloaded(F...) -> Overloaded<F...>;
 
 // The US76 temperature range over [h0, h1]: the profile is piecewise linear
 // in geopotential altitude with kinks at the layer bases, so its extremes lie
