@@ -1,0 +1,50 @@
+// Everything a path needs to know about the world: the atmosphere and its
+// tracking structures, the sun, the observer, and the spectral range.
+//
+// Parameters (built from a request's specs by Scene::from_specs):
+//   atmosphere            planet, shell, constituents, ground
+//   sun                   position, disk, irradiance
+//   observer_altitude_m   the camera / probe position above the ground (on +z)
+//   lambda_min/max_nm     the wavelengths paths may carry (majorants cover them)
+//   environment_radiance  uniform radiance arriving from beyond the atmosphere,
+//                         W m^-2 sr^-1 nm^-1 (0 in real skies; the furnace tests use it)
+//   sun_enabled           false removes the sun (furnace tests)
+#pragma once
+#include <memory>
+#include <optional>
+
+#include <glm/vec3.hpp>
+
+#include "common/atmosphere/atmosphere.h"
+#include "common/atmosphere/atmosphere_spec.h"
+#include "common/render/atmosphere_medium.h"
+#include "common/sun/sun.h"
+
+namespace skyfarm {
+
+class Scene {
+ public:
+  Scene(Atmosphere atmosphere, Sun sun, double observer_altitude_m, double lambda_min_nm, double lambda_max_nm);
+  static Scene from_specs(const AtmosphereSpec& atmosphere, const SunSpec& sun, const Location& location,
+                          const std::optional<UtcInstant>& time, double lambda_min_nm, double lambda_max_nm);
+
+  const Atmosphere& atmosphere() const { return *atmosphere_; }
+  const AtmosphereMedium& medium() const { return *medium_; }
+  const Sun& sun() const { return sun_; }
+  // Planet-centred observer position (0, 0, R + altitude).
+  glm::dvec3 observer() const { return observer_; }
+  double lambda_min_nm() const { return lambda_min_; }
+  double lambda_max_nm() const { return lambda_max_; }
+
+  double environment_radiance = 0.0;
+  bool sun_enabled = true;
+
+ private:
+  std::unique_ptr<Atmosphere> atmosphere_;
+  std::unique_ptr<AtmosphereMedium> medium_;
+  Sun sun_;
+  glm::dvec3 observer_;
+  double lambda_min_, lambda_max_;
+};
+
+}  // namespace skyfarm

@@ -1,0 +1,318 @@
+#include "common/render/volume_path_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "common/core/constants.h"
+#include "common/core/math.h"
+#include "common/geometry/sphere_intersection.h"
+#include "common/render/free_flight.h"
+#include "common/sampling/warps.h"
+
+namespace skyfarm {
+namespace {
+
+// Rays leaving the ground start this far above it, so a ray going up can
+// never meet the sphere it starts on (a convex surface), whatever the round-off.
+constexpr double kGroundOffset_m = 1e-6;
+
+SampledSpectrum clamp_zero(const SampledSpectrum& s) {
+  SampledSpectrum r;
+  for (int i = 0; i < kWavelengthsPerPath; ++i) r[i] = std::max(0.0, s[i]);
+  return r;
+}
+
+// Where a ray is in the atmosphere: [t_begin, t_end], and whether it ends on the ground.
+struct RayExtent {
+  bool in_atmosphere = false;
+  double t_begin = 0.0, t_end = 0.0;
+  bool hits_ground = false;
+};
+
+RayExtent ray_extent(const Ray& ray, const Atmosphere& atmosphere) {
+  RayExtent e;
+  const SphereHit top = intersect_sphere(ray, atmosphere.top_radius_m());
+  const double t_ground = distance_to_sphere(ray, atmosphere.planet_radius_m());
+  e.hits_ground = t_ground > 0.0;
+  if (top.hit && top.t_far > 0.0) {
+    e.in_atmosphere = true;
+    e.t_begin = std::max(0.0, top.t_near);
+    e.t_end = top.t_far;
+  }
+  if (e.hits_ground) e.t_end = t_ground;
+  return e;
+}
+
+// The mixture phase function p_i(mu) = sum_s sigma_s,s(l_i) p_s(mu; l_i) / sigma_s(l_i).
+SampledSpectrum mixture_phase(const MediumPoint& mp, const PathPhases& phases, double mu) {
+  SampledSpectrum p(0.0);
+  for (int s = 0; s < phases.count(); ++s)
+    for (int i = 0; i < kWavelengthsPerPath; ++i)
+      if (mp.sigma_s_c[static_cast<std::size_t>(s)][i] > 0.0)
+        p[i] += mp.sigma_s_c[static_cast<std::size_t>(s)][i] * phases.eval(s, i, mu);
+  return safe_div(p, mp.sigma_s);
+}
+
+}  // namespace
+
+// A scattering vertex: in the medium (phase function) or on the ground (Lambert).
+struct VolumePathIntegrator::Vertex {
+  glm::dvec3 p;
+  glm::dvec3 wo_propagation;  // direction the path arrived along
+  bool on_ground = false;
+  glm::dvec3 n;               // ground normal
+  const MediumPoint* medium = nullptr;
+  const PathPhases* phases = nullptr;
+  SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
+};
+
+VolumePathIntegrator::VolumePathIntegrator(const Scene& scene, IntegratorOptions options)
+    : scene_(scene), options_(options) {}
+
+SampledSpectrum VolumePathIntegrator::radiance(const Ray& ray, const SampledWavelengths& lambda, Sampler& sampler,
+                                               PathCounters* counters) const {
+  const SampledSpectrum L = radiance_unchecked(ray, lambda, sampler, counters);
+  ++counters->paths;
+  // The NaN/Inf firewall: nothing but finite, non-negative radiance reaches a film.
+  for (int i = 0; i < kWavelengthsPerPath; ++i) {
+    if (!std::isfinite(L[i]) || L[i] < 0.0) {
+      ++counters->nonfinite;
+      return SampledSpectrum(0.0);
+    }
+  }
+  return L;
+}
+
+SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledWavelengths& lambda,
+                                                         Sampler& sampler, PathCounters* counters) const {
+  const AtmosphereMedium& medium = scene_.medium();
+  const Atmosphere& atmosphere = scene_.atmosphere();
+  const Sun& sun = scene_.sun();
+  const auto bins = medium.bins(lambda);
+  const PathPhases phases = medium.phases(lambda);
+
+  SampledSpectrum L(0.0), beta(1.0), r_u(1.0), r_l(1.0);
+  bool mis_with_sun = false;  // the previous vertex sampled the sun (NEE)
+  MediumPoint mp;
+
+  for (int depth = 0;; ++depth) {
+    const RayExtent extent = ray_extent(ray, atmosphere);
+    bool scattered = false, absorbed = false;
+
+    // --- Through the medium: delta tracking with spectral MIS.
+    if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
+      const SampledSpectrum T_maj = sample_t_maj(
+          medium, ray, extent.t_begin, extent.t_end, lambda, bins, sampler, mp,
+          [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
+            ++counters->collisions;
+            const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
+            const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
+            const double u = sampler.next();
+            if (u < p_absorb) {
+              absorbed = true;
+              return false;
+            }
+            if (u < p_absorb + p_scatter) {
+              // Real scattering: pdf of this event for the hero, T_maj sigma_s.
+              const double pdf = T_maj_seg[0] * mp.sigma_s[0];
+              beta *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              r_u *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              if (beta.is_zero() || r_u.is_zero()) {
+                absorbed = true;
+                return false;
+              }
+              Vertex v{p, ray.d, false, {}, &mp, &phases, beta, r_u};
+              if (scene_.sun_enabled) L += sample_sun(v, lambda, sampler, counters);
+              // Continue along a direction from the mixture phase function:
+              // pick a constituent by its share of sigma_s at the hero
+              // wavelength, then sample its phase function.
+              double pick = sampler.next() * mp.sigma_s[0];
+              int s = 0;
+              while (s + 1 < phases.count() && pick >= mp.sigma_s_c[static_cast<std::size_t>(s)][0]) {
+                pick -= mp.sigma_s_c[static_cast<std::size_t>(s)][0];
+                ++s;
+              }
+              const double mu = clamp_cos(phases.sample_cos_theta(s, sampler.next()));
+              const double phi = 2.0 * kPi * sampler.next();
+              const double sin_theta = safe_sqrt(1.0 - mu * mu);
+              const glm::dvec3 wi = glm::normalize(
+                  Frame(ray.d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
+              const SampledSpectrum p_mix = mixture_phase(mp, phases, mu);
+              const double pdf_dir = p_mix[0];
+              if (!(pdf_dir > 0.0)) {
+                absorbed = true;
+                return false;
+              }
+              const SampledSpectrum ratio = p_mix * (1.0 / pdf_dir);
+              r_l = r_u * (1.0 / pdf_dir);
+              beta *= ratio;
+              r_u *= ratio;
+              ray = Ray{p, wi};
+              scattered = true;
+              return false;
+            }
+            // Null collision.
+            const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+            const double pdf = T_maj_seg[0] * sigma_n[0];
+            if (!(pdf > 0.0)) {
+              beta = SampledSpectrum(0.0);
+              return false;
+            }
+            beta *= T_maj_seg * sigma_n * (1.0 / pdf);
+            r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
+            r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
+            return !beta.is_zero() && !r_u.is_zero();
+          });
+      if (absorbed || beta.is_zero()) return L;
+      if (!scattered) {
+        const double T0 = T_maj[0];
+        beta *= T_maj * (1.0 / T0);
+        r_u *= T_maj * (1.0 / T0);
+        r_l *= T_maj * (1.0 / T0);
+      }
+    }
+
+    if (!scattered) {
+      if (extent.hits_ground) {
+        // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
+        const glm::dvec3 n = glm::normalize(ray.at(extent.t_end));
+        const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
+        Vertex v{p, ray.d, true, n, nullptr, nullptr, beta, r_u};
+        if (scene_.sun_enabled) L += sample_sun(v, lambda, sampler, counters);
+        double pdf = 0.0;
+        const glm::dvec3 wi = atmosphere.ground().sample_direction(n, sampler.next(), sampler.next(), &pdf);
+        if (!(pdf > 0.0)) return L;
+        // f cos / pdf = rho for Lambert (pdf = cos / pi).
+        for (int i = 0; i < kWavelengthsPerPath; ++i) beta[i] *= atmosphere.ground().albedo(lambda.lambda_nm[i]);
+        r_l = r_u * (1.0 / pdf);
+        ray = Ray{p, wi};
+      } else {
+        // --- Escaped: the sun disk (with MIS if the last vertex sampled it) and the environment.
+        if (scene_.sun_enabled && sun.contains(ray.d)) {
+          SampledSpectrum Le;
+          for (int i = 0; i < kWavelengthsPerPath; ++i) Le[i] = sun.radiance(lambda.lambda_nm[i]);
+          if (!mis_with_sun) {
+            L += beta * Le * (1.0 / r_u.average());
+          } else {
+            r_l *= sun.pdf(ray.d);
+            L += beta * Le * (1.0 / (r_u + r_l).average());
+          }
+        }
+        if (scene_.environment_radiance > 0.0)
+          L += beta * scene_.environment_radiance * (1.0 / r_u.average());
+        return L;
+      }
+    }
+    mis_with_sun = scene_.sun_enabled && !sun.is_point();
+
+    // --- Russian roulette on the MIS-normalised throughput.
+    if (beta.is_zero()) return L;
+    const SampledSpectrum rr_beta = beta * (1.0 / r_u.average());
+    if (depth + 1 >= options_.rr_start_depth && rr_beta.max() < 1.0) {
+      const double q = std::max(0.0, 1.0 - rr_beta.max());
+      if (sampler.next() < q) return L;
+      beta *= 1.0 / (1.0 - q);
+    }
+    if (depth + 1 >= options_.max_depth) {
+      ++counters->depth_limit;
+      return L;
+    }
+  }
+}
+
+// Next-event estimation of the sun from a vertex (pbrt-v4 SampleLd, with
+// per-wavelength scattering pdfs because the mixture phase depends on l):
+//   L_d = beta f T L_sun / avg_i(r_p,i (pdf_light r_l,ray,i + pdf_scatter,i r_u,ray,i)),
+// balance heuristic between sampling the sun and sampling the phase/BRDF
+// (for a point sun only the former exists).
+SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
+                                                 PathCounters* counters) const {
+  const Sun& sun = scene_.sun();
+  const Atmosphere& atmosphere = scene_.atmosphere();
+  const double u1 = sampler.next(), u2 = sampler.next();
+  double pdf_light = 0.0;
+  const glm::dvec3 wi = sun.sample_direction(u1, u2, &pdf_light);
+
+  // Scattering value f and its sampling pdf for each wavelength.
+  SampledSpectrum f, pdf_scatter;
+  if (v.on_ground) {
+    const double cos_theta = glm::dot(v.n, wi);
+    if (cos_theta <= 0.0) return SampledSpectrum(0.0);
+    for (int i = 0; i < kWavelengthsPerPath; ++i)
+      f[i] = atmosphere.ground().brdf(lambda.lambda_nm[i], cos_theta) * cos_theta;
+    pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
+  } else {
+    f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
+    pdf_scatter = f;
+  }
+  if (f.is_zero()) return SampledSpectrum(0.0);
+
+  // Shadow ray: blocked by the planet, else ratio tracking to the top.
+  const Ray shadow{v.p, wi};
+  if (distance_to_sphere(shadow, atmosphere.planet_radius_m()) > 0.0) return SampledSpectrum(0.0);
+  const SphereHit top = intersect_sphere(shadow, atmosphere.top_radius_m());
+  SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
+  if (top.hit && top.t_far > 0.0) {
+    const AtmosphereMedium& medium = scene_.medium();
+    MediumPoint mp;
+    const SampledSpectrum T_maj = sample_t_maj(
+        medium, shadow, std::max(0.0, top.t_near), top.t_far, lambda, medium.bins(lambda), sampler, mp,
+        [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
+          ++counters->collisions;
+          const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+          const double pdf = T_maj_seg[0] * sigma_maj[0];
+          T_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+          r_l_ray *= T_maj_seg * sigma_maj * (1.0 / pdf);
+          r_u_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+          // Russian roulette once the MIS-weighted transmittance is small.
+          const SampledSpectrum Tr = T_ray * (1.0 / (r_l_ray + r_u_ray).average());
+          if (Tr.max() < 0.05) {
+            const double q = 0.75;
+            if (sampler.next() < q)
+              T_ray = SampledSpectrum(0.0);
+            else
+              T_ray *= 1.0 / (1.0 - q);
+          }
+          return !T_ray.is_zero();
+        });
+    if (T_ray.is_zero()) return SampledSpectrum(0.0);
+    const double T0 = T_maj[0];
+    T_ray *= T_maj * (1.0 / T0);
+    r_l_ray *= T_maj * (1.0 / T0);
+    r_u_ray *= T_maj * (1.0 / T0);
+  }
+
+  SampledSpectrum Le;
+  for (int i = 0; i < kWavelengthsPerPath; ++i) Le[i] = sun.radiance(lambda.lambda_nm[i]);
+  const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
+  const SampledSpectrum Ld = v.beta * f * T_ray * Le;
+  if (sun.is_point()) return Ld * (1.0 / r_l.average());
+  const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
+  return Ld * (1.0 / (r_l + r_u).average());
+}
+
+SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda,
+                                                    Sampler& sampler, PathCounters* counters) const {
+  const AtmosphereMedium& medium = scene_.medium();
+  const SphereHit top = intersect_sphere(ray, scene_.atmosphere().top_radius_m());
+  if (!top.hit || top.t_far <= 0.0) return SampledSpectrum(1.0);
+  const double t0 = std::max(0.0, top.t_near), t1 = std::min(t_end, top.t_far);
+  if (t1 <= t0) return SampledSpectrum(1.0);
+  MediumPoint mp;
+  SampledSpectrum T_ray(1.0);
+  const SampledSpectrum T_maj = sample_t_maj(
+      medium, ray, t0, t1, lambda, medium.bins(lambda), sampler, mp,
+      [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
+        ++counters->collisions;
+        // Ratio tracking: T *= sigma_n / sigma_maj (hero), times the other
+        // wavelengths' majorant-transmittance ratios.
+        const SampledSpectrum sigma_n = sigma_maj - mp.sigma_a - mp.sigma_s;
+        T_ray *= T_maj_seg * sigma_n * (1.0 / (T_maj_seg[0] * sigma_maj[0]));
+        return true;
+      });
+  return T_ray * T_maj * (1.0 / T_maj[0]);
+}
+
+}  // namespace skyfarm

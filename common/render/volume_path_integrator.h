@@ -1,0 +1,78 @@
+// The reference spectral path tracer of the atmosphere (DESIGN §3.4).
+//
+// Per path: kWavelengthsPerPath wavelengths; free-flight distances sampled
+// with the hero wavelength's per-shell majorant (delta tracking through the
+// null-scattering formulation of Miller, Georgiev & Jarosz 2019, "A null-
+// scattering path integral formulation of light transport"), and the other
+// wavelengths carried by spectral MIS: r_u and r_l hold, per wavelength, the
+// path pdf had that wavelength been the hero, relative to the hero's (pbrt-v4
+// VolPathIntegrator; notes/render-core.md §1.2).  At every real scattering
+// vertex and ground hit: next-event estimation of the sun disk with
+// transmittance by ratio tracking (with Russian roulette on small
+// transmittance), combined with phase / BRDF sampling by MIS (balance
+// heuristic) where both can reach the sun; multiple scattering of any order
+// with Russian roulette on the throughput; Lambertian ground.
+//
+// Options:
+//   max_depth         hard cap on scattering events (a cost bound; hits are
+//                     counted in PathCounters::depth_limit so tests keep it 0)
+//   rr_start_depth    Russian roulette on throughput from this depth on
+#pragma once
+#include <cstdint>
+
+#include "common/geometry/ray.h"
+#include "common/render/scene.h"
+#include "common/sampling/sampler.h"
+#include "common/spectrum/sampled_spectrum.h"
+
+namespace skyfarm {
+
+struct IntegratorOptions {
+  int max_depth = 10000;
+  int rr_start_depth = 2;
+};
+
+// Counters a renderer sums over its paths.
+struct PathCounters {
+  std::uint64_t paths = 0;
+  std::uint64_t collisions = 0;    // tentative collisions (real + null), camera and shadow rays
+  std::uint64_t nonfinite = 0;     // path results rejected by the NaN/Inf/negative firewall
+  std::uint64_t depth_limit = 0;   // paths cut by max_depth
+  void add(const PathCounters& o) {
+    paths += o.paths;
+    collisions += o.collisions;
+    nonfinite += o.nonfinite;
+    depth_limit += o.depth_limit;
+  }
+};
+
+class VolumePathIntegrator {
+ public:
+  explicit VolumePathIntegrator(const Scene& scene, IntegratorOptions options = {});
+
+  // Spectral radiance (W m^-2 sr^-1 nm^-1) arriving along -ray.d at ray.o, at
+  // the path's wavelengths.  Always finite and >= 0 (the firewall zeroes and
+  // counts anything else).
+  SampledSpectrum radiance(const Ray& ray, const SampledWavelengths& lambda, Sampler& sampler,
+                           PathCounters* counters) const;
+
+  // An unbiased estimate of the transmittance between ray.o and ray.at(t_end)
+  // at the path's wavelengths by ratio tracking, with the hero wavelength's
+  // majorants (no Russian roulette): E[result_i] = exp(-tau_i).
+  SampledSpectrum transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda, Sampler& sampler,
+                                PathCounters* counters) const;
+
+  const Scene& scene() const { return scene_; }
+
+ private:
+  struct Vertex;
+  SampledSpectrum radiance_unchecked(Ray ray, const SampledWavelengths& lambda, Sampler& sampler,
+                                     PathCounters* counters) const;
+  SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
+                             PathCounters* counters) const;
+
+  const Scene& scene_;
+  IntegratorOptions options_;
+};
+
+}  // namespace skyfarm
