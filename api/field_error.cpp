@@ -13,8 +13,10 @@ std::string join(const std::vector<FieldError>& errors) {
 }  // namespace
 
 std::string FieldError::message() const {
-  std::string m = (path.empty() ? std::string("(request)") : path) + ": " + rule;
-  if (!value.empty()) m += ", got " + value;
+  std::string m;
+  m.reserve(path.size() + rule.size() + value.size() + 16);
+  m.append(path.empty() ? "(request)" : path).append(": ").append(rule);
+  if (!value.empty()) m.append(", got ").append(value);
   return m;
 }
 

@@ -1,8 +1,9 @@
 // skyfarm-worker: the worker side of skyfarm.
+//   skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]
+//   skyfarm-worker probe PROBE.json|- [--threads N]
 //   skyfarm-worker info REQUEST.json [--json]   the request's sun and optical depths
 //   skyfarm-worker --help | --version
-// `render`, `probe` and `bench` arrive with the path tracer (issue 3), the farm
-// worker loop (`--connect`) with the server (issue 4).
+// The farm worker loop (`--connect`) arrives with the server (issue 4).
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -12,6 +13,8 @@
 
 #include "api/field_error.h"
 #include "api/render_request.h"
+#include "worker/cli_io.h"
+#include "worker/render_command.h"
 #include "worker/sky_report.h"
 
 namespace {
@@ -20,28 +23,16 @@ constexpr const char* kUsage =
     "usage: skyfarm-worker <command> [options]\n"
     "\n"
     "commands:\n"
+    "  render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]\n"
+    "                                render a request on this machine (all cores by default)\n"
+    "  probe PROBE.json [--threads N] spectral radiance in given directions, JSON on stdout\n"
+    "                                (PROBE.json may be '-' for standard input)\n"
     "  info REQUEST.json [--json]   sun position and optical depths of a render request\n"
     "                                (REQUEST.json may be '-' for standard input)\n"
     "\n"
     "options:\n"
     "  --help      this text\n"
     "  --version   the skyfarm version\n";
-
-bool read_input(const std::string& path, std::string* text, std::string* error) {
-  std::ostringstream buffer;
-  if (path == "-") {
-    buffer << std::cin.rdbuf();
-  } else {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) {
-      *error = "cannot open " + path;
-      return false;
-    }
-    buffer << in.rdbuf();
-  }
-  *text = buffer.str();
-  return true;
-}
 
 int run_info(const std::vector<std::string>& args) {
   std::string path;
@@ -61,7 +52,7 @@ int run_info(const std::vector<std::string>& args) {
     return 2;
   }
   std::string text, error;
-  if (!read_input(path, &text, &error)) {
+  if (!skyfarm::read_input(path, &text, &error)) {
     std::cerr << "skyfarm-worker info: " << error << "\n";
     return 1;
   }
@@ -94,6 +85,8 @@ int main(int argc, char** argv) {
   const std::string command = args[0];
   args.erase(args.begin());
   if (command == "info") return run_info(args);
+  if (command == "render") return skyfarm::run_render_command(args);
+  if (command == "probe") return skyfarm::run_probe_command(args);
   std::cerr << "skyfarm-worker: unknown command '" << command << "'\n" << kUsage;
   return 2;
 }

@@ -65,7 +65,7 @@ nlohmann::json sky_report(const api::RenderRequest& request) {
   // Direct sun from the observer: slant optical depth and transmittance, or
   // the planet in the way.
   const Ray to_sun{{0.0, 0.0, atmosphere.planet_radius_m() + request.location.altitude_m}, sun.direction()};
-  const bool blocked = distance_to_sphere(to_sun, atmosphere.planet_radius_m()) > 0.0;
+  const bool blocked = ground_distance(to_sun, atmosphere.planet_radius_m()) >= 0.0;
   nlohmann::json direct = {{"blocked_by_planet", blocked}};
   if (!blocked) {
     std::vector<double> tau, T;

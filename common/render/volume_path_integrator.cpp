@@ -34,8 +34,8 @@ struct RayExtent {
 RayExtent ray_extent(const Ray& ray, const Atmosphere& atmosphere) {
   RayExtent e;
   const SphereHit top = intersect_sphere(ray, atmosphere.top_radius_m());
-  const double t_ground = distance_to_sphere(ray, atmosphere.planet_radius_m());
-  e.hits_ground = t_ground > 0.0;
+  const double t_ground = ground_distance(ray, atmosphere.planet_radius_m());
+  e.hits_ground = t_ground >= 0.0;
   if (top.hit && top.t_far > 0.0) {
     e.in_atmosphere = true;
     e.t_begin = std::max(0.0, top.t_near);
@@ -251,7 +251,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
 
   // Shadow ray: blocked by the planet, else ratio tracking to the top.
   const Ray shadow{v.p, wi};
-  if (distance_to_sphere(shadow, atmosphere.planet_radius_m()) > 0.0) return SampledSpectrum(0.0);
+  if (ground_distance(shadow, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
   const SphereHit top = intersect_sphere(shadow, atmosphere.top_radius_m());
   SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
   if (top.hit && top.t_far > 0.0) {

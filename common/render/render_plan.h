@@ -1,0 +1,56 @@
+// How a render is cut into units of work (DESIGN §4): image tiles x
+// wavelength batches x sample passes.  A pure function of the request, so a
+// unit means the same samples wherever and whenever it is rendered.
+//
+//   tile_size          square tiles of this many pixels (edge tiles smaller)
+//   samples_per_pass   samples per pixel in one pass (the last may be short)
+//   batches            equal wavelength batches of [lambda_min, lambda_max]
+//
+// Unit (tile t, batch b, pass p) renders samples [p S, min((p+1) S, spp)) of
+// every pixel of tile t at wavelengths in batch b, with random numbers keyed
+// by (seed of batch b, pixel index y W + x, sample index, dimension).  Units
+// of one tile are merged in pass order (then batch order), so the sums are
+// bit-identical however the units were scheduled.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "common/camera/camera_spec.h"
+
+namespace skyfarm {
+
+struct WorkUnit {
+  int tile = 0, batch = 0, pass = 0;
+};
+
+struct RenderPlan {
+  int width = 0, height = 0;
+  int tile_size = 32;
+  int tiles_x = 0, tiles_y = 0;
+  int batches = 1;
+  double lambda_min_nm = 360.0, lambda_max_nm = 830.0;
+  int samples_per_pixel = 1;
+  int samples_per_pass = 16;
+  int passes = 1;
+  std::uint64_t seed = 1;
+
+  int tile_count() const { return tiles_x * tiles_y; }
+  int unit_count() const { return tile_count() * batches * passes; }
+  // Pixel rectangle of tile t.
+  void tile_rect(int tile, int* x0, int* y0, int* w, int* h) const;
+  // Samples [first, end) of pass p.
+  int pass_first_sample(int pass) const { return pass * samples_per_pass; }
+  int pass_end_sample(int pass) const;
+  // Wavelength range of batch b (shared edges are bit-identical).
+  double batch_min_nm(int batch) const;
+  double batch_max_nm(int batch) const;
+  // The seed of batch b's random numbers.
+  std::uint64_t batch_seed(int batch) const;
+  // Units in canonical order: tile-major, then pass, then batch.
+  std::vector<WorkUnit> units() const;
+};
+
+RenderPlan make_render_plan(int width, int height, double lambda_min_nm, double lambda_max_nm, int batches,
+                            int samples_per_pixel, std::uint64_t seed, int tile_size = 32, int samples_per_pass = 16);
+
+}  // namespace skyfarm

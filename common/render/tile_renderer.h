@@ -1,0 +1,35 @@
+// Renders units of work (render_plan.h) into film tiles: for each pixel of
+// the tile and each sample of the pass, a jittered camera ray (box filter),
+// hero wavelengths importance-sampled inside the unit's batch, one path, and
+// its XYZ and band radiance added to the film.  Samples whose film point has
+// no direction (outside a fisheye's circle) are not counted, so an edge
+// pixel is the mean over its part inside the circle.
+#pragma once
+#include "common/camera/camera.h"
+#include "common/film/film_tile.h"
+#include "common/render/render_plan.h"
+#include "common/render/volume_path_integrator.h"
+
+namespace skyfarm {
+
+class TileRenderer {
+ public:
+  TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan, IntegratorOptions options = {});
+
+  // A fresh film tile for tile t (all batches, zero).
+  FilmTile empty_tile(int tile) const;
+  // Adds the samples of one unit to `film` (which must be tile unit.tile).
+  void render_unit(const WorkUnit& unit, FilmTile* film, PathCounters* counters) const;
+  // All passes and batches of a tile, merged in canonical order.
+  FilmTile render_tile(int tile, PathCounters* counters) const;
+
+  const RenderPlan& plan() const { return plan_; }
+
+ private:
+  const Scene& scene_;
+  const Camera& camera_;
+  RenderPlan plan_;
+  VolumePathIntegrator integrator_;
+};
+
+}  // namespace skyfarm

@@ -1,0 +1,215 @@
+#include "worker/render_command.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <algorithm>
+#include <optional>
+
+#include "api/field_error.h"
+#include "api/probe_request.h"
+#include "api/render_request.h"
+#include "common/core/constants.h"
+#include "common/image/exr_writer.h"
+#include "common/image/png_writer.h"
+#include "common/render/local_render.h"
+#include "common/render/parallel.h"
+#include "common/render/radiance_probe.h"
+#include "worker/cli_io.h"
+
+namespace skyfarm {
+namespace {
+
+struct RenderArgs {
+  std::string request, exr, png;
+  int threads = 0;
+};
+
+// Parses "REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]"; returns an error text or "".
+std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* out) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    if ((a == "-o" || a == "--output") && has_value) {
+      out->exr = args[++i];
+    } else if (a == "--png" && has_value) {
+      out->png = args[++i];
+    } else if (a == "--threads" && has_value) {
+      try {
+        out->threads = std::stoi(args[++i]);
+      } catch (const std::exception&) {
+        return "--threads: must be an integer, got '" + args[i] + "'";
+      }
+      if (out->threads < 0) return "--threads: must be >= 0 (0 = all cores)";
+    } else if (!a.empty() && a[0] == '-' && a != "-") {
+      return "unknown or incomplete option '" + a + "'";
+    } else if (out->request.empty()) {
+      out->request = a;
+    } else {
+      return "unexpected argument '" + a + "'";
+    }
+  }
+  if (out->request.empty()) return "a request file is required";
+  if (out->exr.empty()) return "-o OUT.exr is required";
+  return "";
+}
+
+void set_metadata(Image* image, const api::RenderRequest& request, const Scene& scene, const RenderPlan& plan,
+                  double estimated_rms) {
+  namespace key = metadata_key;
+  image->set_metadata(key::kRequest, api::canonical_text(request));
+  image->set_metadata(key::kSunZenithDeg, scene.sun().zenith_deg());
+  image->set_metadata(key::kSunAzimuthDeg, scene.sun().azimuth_deg());
+  image->set_metadata(key::kSamplesPerPixel, static_cast<double>(plan.samples_per_pixel));
+  image->set_metadata(key::kWavelengthMinNm, plan.lambda_min_nm);
+  image->set_metadata(key::kWavelengthMaxNm, plan.lambda_max_nm);
+  image->set_metadata(key::kSoftwareVersion, std::string("skyfarm ") + SKYFARM_VERSION);
+  image->set_metadata(key::kEstimatedRelativeRms, estimated_rms);
+  image->set_metadata("method", std::string("path"));
+  image->set_metadata("earth_sun_distance_au", scene.sun().distance_au());
+}
+
+}  // namespace
+
+int run_render_command(const std::vector<std::string>& args) {
+  RenderArgs a;
+  if (const std::string err = parse_render_args(args, &a); !err.empty()) {
+    std::cerr << "skyfarm-worker render: " << err
+              << "\nusage: skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]\n";
+    return 2;
+  }
+  std::string text, error;
+  if (!read_input(a.request, &text, &error)) {
+    std::cerr << "skyfarm-worker render: " << error << "\n";
+    return 1;
+  }
+  try {
+    const api::RenderRequest request = api::parse_render_request(text);
+    if (request.method == api::Method::kLut) {
+      std::cerr << "skyfarm-worker render: method \"lut\" is not available yet; use \"path\"\n";
+      return 2;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
+                                          request.spectral.min_nm, request.spectral.max_nm);
+    const Camera camera(request.camera, scene.observer());
+    const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                                             request.spectral.max_nm, request.spectral.batches,
+                                             request.quality.samples_per_pixel, request.seed);
+    const TileRenderer renderer(scene, camera, plan);
+    ImageLayers layers;
+    if (request.output.spectral_channels)
+      layers.spectral = SpectralLayout{plan.lambda_min_nm, plan.lambda_max_nm, plan.batches};
+    layers.relative_error = request.output.error_layer;
+    Image image(plan.width, plan.height, layers);
+    std::fprintf(stderr, "rendering %dx%d, %d spp, %d batches, %d tiles, sun at zenith %.3f deg azimuth %.3f deg\n",
+                 plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
+                 scene.sun().zenith_deg(), scene.sun().azimuth_deg());
+    ProgressDisplay progress("render");
+    const LocalRenderResult result =
+        render_image(renderer, &image, a.threads, [&](int done, int total) { progress.update(done, total); });
+    progress.finish();
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    set_metadata(&image, request, scene, plan, result.estimated_relative_rms);
+
+    ExrWriteOptions exr;
+    exr.half = request.output.half;
+    exr.spectral_channels = request.output.spectral_channels;
+    exr.error_layer = request.output.error_layer;
+    exr.latlong_envmap = request.camera.projection == Projection::kEquirectangular;
+    const ExrWriteReport exr_report = write_exr(image, a.exr, exr);
+    std::printf("wrote %s\n", a.exr.c_str());
+    if (exr_report.clamped_half_values > 0)
+      std::printf("note: %zu values above the half-float range (65504, e.g. the sun disk) were clamped; "
+                  "set \"output\": {\"half\": false} to keep them\n",
+                  exr_report.clamped_half_values);
+    if (!a.png.empty()) {
+      PngWriteOptions png;
+      png.exposure_ev = request.output.exposure_ev;
+      const PngWriteReport r = write_png(image, a.png, png);
+      std::printf("wrote %s (exposure EV100 %.2f)\n", a.png.c_str(), r.exposure_ev);
+    }
+    const double paths = static_cast<double>(result.counters.paths);
+    std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g samples/s per thread), estimated relative RMS error %.4f\n",
+                seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(a.threads),
+                result.estimated_relative_rms);
+    if (result.counters.nonfinite > 0)
+      std::printf("warning: %llu non-finite or negative path results were discarded\n",
+                  static_cast<unsigned long long>(result.counters.nonfinite));
+    return 0;
+  } catch (const api::ValidationError& e) {
+    std::cerr << a.request << ": invalid request\n" << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-worker render: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+int run_probe_command(const std::vector<std::string>& args) {
+  std::string path;
+  int threads = 0;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--threads" && i + 1 < args.size()) {
+      try {
+        threads = std::stoi(args[++i]);
+      } catch (const std::exception&) {
+        std::cerr << "skyfarm-worker probe: --threads must be an integer\n";
+        return 2;
+      }
+    } else if (path.empty()) {
+      path = args[i];
+    } else {
+      std::cerr << "skyfarm-worker probe: unexpected argument '" << args[i] << "'\n";
+      return 2;
+    }
+  }
+  if (path.empty()) path = "-";
+  std::string text, error;
+  if (!read_input(path, &text, &error)) {
+    std::cerr << "skyfarm-worker probe: " << error << "\n";
+    return 1;
+  }
+  try {
+    const api::ProbeRequest request = api::parse_probe_request(text);
+    if (request.method == api::Method::kLut) {
+      std::cerr << "skyfarm-worker probe: method \"lut\" is not available yet; use \"path\"\n";
+      return 2;
+    }
+    const auto [lmin, lmax] = std::minmax_element(request.wavelengths_nm.begin(), request.wavelengths_nm.end());
+    // The majorant grid must cover every asked wavelength; 1 nm margin.
+    const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
+                                          *lmin - 0.5, *lmax + 0.5);
+    std::vector<glm::dvec3> dirs;
+    nlohmann::json dirs_json = nlohmann::json::array();
+    for (const auto& d : request.directions) {
+      dirs.push_back(direction_from_zenith_azimuth(d.zenith_deg * kDegToRad, d.azimuth_deg * kDegToRad));
+      dirs_json.push_back({{"zenith_deg", d.zenith_deg}, {"azimuth_deg", d.azimuth_deg}});
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    const ProbeResult r = probe_radiance(scene, dirs, request.wavelengths_nm, request.samples, request.seed, threads);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    nlohmann::json out = {{"units", "W m-2 sr-1 nm-1"},
+                          {"wavelengths_nm", request.wavelengths_nm},
+                          {"directions", dirs_json},
+                          {"radiance", r.radiance},
+                          {"standard_error", r.standard_error},
+                          {"samples", request.samples},
+                          {"seed", request.seed},
+                          {"method", "path"},
+                          {"sun", {{"zenith_deg", scene.sun().zenith_deg()}, {"azimuth_deg", scene.sun().azimuth_deg()}}},
+                          {"elapsed_s", seconds},
+                          {"nonfinite_paths", r.counters.nonfinite}};
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  } catch (const api::ValidationError& e) {
+    std::cerr << path << ": invalid probe request\n" << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-worker probe: " << e.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace skyfarm
