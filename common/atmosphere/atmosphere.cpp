@@ -64,8 +64,8 @@ double Atmosphere::optical_depth(const Ray& ray, double t_max, double lambda_nm)
   if (!top.hit) return 0.0;
   double t0 = std::max(0.0, top.t_near);
   double t1 = std::min(t_max, top.t_far);
-  const double t_ground = distance_to_sphere(ray, planet_radius_m_);
-  if (t_ground > 0.0) t1 = std::min(t1, t_ground);
+  const double t_ground = ground_distance(ray, planet_radius_m_);
+  if (t_ground >= 0.0) t1 = std::min(t1, t_ground);
   if (t1 <= t0) return 0.0;
   auto sigma_t_at = [&](double t) { return sigma_t(altitude_above(ray.at(t), planet_radius_m_), lambda_nm); };
   // Split at the closest approach to the centre (where the altitude turns).

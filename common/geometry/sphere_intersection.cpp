@@ -37,6 +37,12 @@ double distance_to_sphere(const Ray& ray, double radius) {
   return -1.0;
 }
 
+double ground_distance(const Ray& ray, double radius) {
+  if (glm::length(ray.o) <= radius) return glm::dot(ray.o, ray.d) < 0.0 ? 0.0 : -1.0;
+  const SphereHit h = intersect_sphere(ray, radius);
+  return (h.hit && h.t_near >= 0.0) ? h.t_near : -1.0;
+}
+
 double altitude_above(const glm::dvec3& p, double radius) { return glm::length(p) - radius; }
 
 double horizon_cosine(double r, double R) { return -safe_sqrt((r - R) * (r + R)) / r; }

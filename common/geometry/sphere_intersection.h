@@ -32,6 +32,13 @@ SphereHit intersect_sphere(const Ray& ray, double radius);
 // negative number when there is none.
 double distance_to_sphere(const Ray& ray, double radius);
 
+// Distance along the ray to the ground, a sphere of `radius` seen from above:
+// the near root when the origin is above it; 0 when the origin is on (or,
+// by round-off, just below) the surface and the ray points into it; -1 when
+// the ray never meets it.  A camera standing on the ground (altitude 0) thus
+// sees the ground at its feet instead of the far side of the planet.
+double ground_distance(const Ray& ray, double radius);
+
 // Altitude of a point above a sphere of `radius`: |p| - radius.
 double altitude_above(const glm::dvec3& p, double radius);
 

@@ -118,3 +118,19 @@ TEST(RayDirections, ZenithAzimuthRoundTrip) {
 
 }  // namespace
 }  // namespace skyfarm
+
+namespace skyfarm {
+namespace {
+
+TEST(SphereIntersection, CameraOnTheGroundSeesTheGroundAtItsFeet) {
+  // At altitude 0 a downward ray meets the ground at once, not on the far side.
+  const Ray down{{0.0, 0.0, R}, direction_from_zenith_azimuth(120.0 * kDegToRad, 0.0)};
+  EXPECT_EQ(ground_distance(down, R), 0.0);
+  const Ray up{{0.0, 0.0, R}, direction_from_zenith_azimuth(60.0 * kDegToRad, 0.0)};
+  EXPECT_LT(ground_distance(up, R), 0.0);
+  const Ray above{{0.0, 0.0, R + 10.0}, {0.0, 0.0, -1.0}};
+  EXPECT_NEAR(ground_distance(above, R), 10.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace skyfarm
