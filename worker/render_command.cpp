@@ -165,7 +165,7 @@ int run_probe_command(const std::vector<std::string>& args) {
       return 2;
     }
   }
-  if (path.empty()) path = "-";
+  if (path.empty()) path.push_back('-');  // standard input
   std::string text, error;
   if (!read_input(path, &text, &error)) {
     std::cerr << "skyfarm-worker probe: " << error << "\n";

@@ -10,7 +10,7 @@ std::vector<double> majorant_shell_boundaries(double top) {
   std::vector<double> b{0.0};
   while (b.back() < top) {
     const double h = b.back();
-    const double dh = h < 2000.0 ? 100.0 : std::min(5000.0, 0.05 * h);
+    const double dh = h < 2000.0 ? 200.0 : std::min(10000.0, 0.1 * h);
     b.push_back(std::min(top, h + dh));
   }
   return b;

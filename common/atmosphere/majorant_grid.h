@@ -7,8 +7,10 @@
 // A product of maxima bounds the max of products, so the bound holds; it is
 // tight to within the variation of rho across a shell and k across a bin.
 //
-// Shells: 100 m thick up to 2 km, then 5 % of their base altitude (at most
-// 5 km) up to the top; wavelength bins of 1 nm (fewer for a short range).
+// Shells: 200 m thick up to 2 km, then 10 % of their base altitude (at most
+// 10 km) up to the top (51 shells for a 100 km atmosphere: every ray pays for
+// each shell it crosses, every loose bound for extra null collisions);
+// wavelength bins of 1 nm (fewer for a short range).
 // Above the top sigma_maj = 0.
 #pragma once
 #include <vector>

@@ -1,15 +1,17 @@
 // Majorant-driven free-flight sampling along a ray through the atmosphere's
 // shells (pbrt-v4 SampleT_maj, re-derived for radial shells).
 //
-// In each shell segment the majorant sigma_maj (per wavelength) is constant.
-// Tentative collisions are drawn with the hero wavelength's majorant,
-// t += -ln(1 - u) / sigma_maj[0]; at each one the callback receives the point,
-// the medium's coefficients there, sigma_maj and T_maj = exp(-sigma_maj dt)
-// since the previous collision (per wavelength), and returns whether to go on.
-// The returned value is T_maj from the last collision (or the start) to the
-// end of the walk; 1 when the callback stopped the walk.  A fresh uniform
-// number is drawn for every step (the exponential is memoryless, a rejected
-// one is not uniform any more).
+// In each shell segment the majorant sigma_maj (per wavelength) is constant,
+// so the hero wavelength's majorant optical depth grows piecewise linearly
+// along the ray.  A tentative collision happens where it reaches a target
+// tau* = -ln(1 - u) drawn once per flight (regular tracking): segments are
+// crossed by subtracting their optical depth from tau*, with no random number
+// or exponential per segment.  At each collision the callback receives the
+// point, sigma_maj there and T_maj = exp(-tau_maj) per wavelength since the
+// previous collision (the medium's coefficients are in `point`), and returns
+// whether to go on; then a fresh tau* is drawn.  The returned value is T_maj
+// from the last collision (or the start) to the end of the walk; 1 when the
+// callback stopped the walk.
 #pragma once
 #include <cmath>
 
@@ -27,33 +29,31 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, dou
                              const std::array<std::size_t, kWavelengthsPerPath>& bins, Sampler& sampler,
                              MediumPoint& point, Callback&& callback) {
   const double R = medium.atmosphere().planet_radius_m();
-  SampledSpectrum T_maj(1.0);
+  SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
+  double tau_target = -std::log1p(-sampler.next());
   ShellTraversal walk(ray, R, medium.shell_bottoms(), t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
     const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, bins);
     double t = segment.t0;
-    // A segment the hero cannot collide in: attenuate by the majorant only.
-    if (sigma_maj[0] == 0.0) {
-      T_maj *= exp_neg(sigma_maj * (segment.t1 - segment.t0));
-      continue;
-    }
     while (true) {
-      const double u = sampler.next();
-      const double dt = -std::log1p(-u) / sigma_maj[0];
-      if (t + dt >= segment.t1) {
-        T_maj *= exp_neg(sigma_maj * (segment.t1 - t));
+      const double tau_rest = sigma_maj[0] * (segment.t1 - t);
+      if (tau_target >= tau_rest) {  // no collision in the rest of this segment
+        tau_target -= tau_rest;
+        tau_maj += sigma_maj * (segment.t1 - t);
         break;
       }
+      const double dt = tau_target / sigma_maj[0];
       t += dt;
-      T_maj *= exp_neg(sigma_maj * dt);
+      tau_maj += sigma_maj * dt;
       const glm::dvec3 p = ray.at(t);
       medium.point(glm::length(p) - R, lambda, &point);
-      if (!callback(t, p, sigma_maj, T_maj)) return SampledSpectrum(1.0);
-      T_maj = SampledSpectrum(1.0);
+      if (!callback(t, p, sigma_maj, exp_neg(tau_maj))) return SampledSpectrum(1.0);
+      tau_maj = SampledSpectrum(0.0);
+      tau_target = -std::log1p(-sampler.next());
     }
   }
-  return T_maj;
+  return exp_neg(tau_maj);
 }
 
 }  // namespace skyfarm

@@ -1,6 +1,7 @@
 #include "common/render/shell_traversal.h"
 
 #include <algorithm>
+#include <cmath>
 #include <glm/geometric.hpp>
 
 #include "common/geometry/sphere_intersection.h"
@@ -10,7 +11,10 @@ namespace skyfarm {
 ShellTraversal::ShellTraversal(const Ray& ray, double planet_radius_m, std::span<const double> shell_bottoms,
                                double t_begin, double t_end)
     : ray_(ray), R_(planet_radius_m), h_(shell_bottoms), t_(t_begin), t_end_(t_end) {
-  t_turn_ = -glm::dot(ray_.o, ray_.d);
+  r0_ = glm::length(ray_.o);
+  b_ = glm::dot(ray_.o, ray_.d);
+  l_ = glm::length(ray_.o - b_ * ray_.d);
+  t_turn_ = -b_;
   inbound_ = t_ < t_turn_;
   const std::size_t K = h_.size() - 1;
   // The shell of the starting point, by its altitude; a point on a boundary
@@ -25,6 +29,21 @@ ShellTraversal::ShellTraversal(const Ray& ray, double planet_radius_m, std::span
   if (!(t_end_ > t_begin)) done_ = true;
 }
 
+bool ShellTraversal::roots(double rho, double* t_near, double* t_far) const {
+  const double D = (rho - l_) * (rho + l_);
+  if (D < 0.0) return false;
+  const double c = (r0_ - rho) * (r0_ + rho);
+  const double q = -(b_ + std::copysign(std::sqrt(D), b_));
+  if (q == 0.0) {
+    *t_near = *t_far = 0.0;
+    return true;
+  }
+  const double t0 = q, t1 = c / q;
+  *t_near = std::min(t0, t1);
+  *t_far = std::max(t0, t1);
+  return true;
+}
+
 bool ShellTraversal::next(ShellSegment* segment) {
   if (done_) return false;
   const std::size_t K = h_.size() - 1;
@@ -34,23 +53,22 @@ bool ShellTraversal::next(ShellSegment* segment) {
   if (inbound_) {
     // Going down: through the bottom of this shell, unless the ray turns
     // around inside it (then on to its top, outbound).
-    const SphereHit bottom = intersect_sphere(ray_, radius(shell_));
-    if (bottom.hit && bottom.t_near >= t_) {
-      t_next = bottom.t_near;
+    double near = 0.0, far = 0.0;
+    if (roots(radius(shell_), &near, &far) && near >= t_) {
+      t_next = near;
       if (shell_ == 0) {
         shell_after = K;  // the ground: nothing below
       } else {
         shell_after = shell_ - 1;
       }
     } else {
-      const SphereHit top = intersect_sphere(ray_, radius(shell_ + 1));
-      t_next = top.hit ? top.t_far : t_end_;
+      t_next = roots(radius(shell_ + 1), &near, &far) ? far : t_end_;
       shell_after = shell_ + 1;
       inbound_after = false;
     }
   } else {
-    const SphereHit top = intersect_sphere(ray_, radius(shell_ + 1));
-    t_next = top.hit ? top.t_far : t_end_;
+    double near = 0.0, far = 0.0;
+    t_next = roots(radius(shell_ + 1), &near, &far) ? far : t_end_;
     shell_after = shell_ + 1;
   }
   t_next = std::max(t_next, t_);

@@ -37,11 +37,15 @@ class ShellTraversal {
 
  private:
   double radius(std::size_t k) const { return R_ + h_[k]; }
+  // Roots of |o + t d| = rho from the cached ray constants (see
+  // sphere_intersection.h for the stable forms); false when the line misses.
+  bool roots(double rho, double* t_near, double* t_far) const;
 
   Ray ray_;
   double R_;
   std::span<const double> h_;
   double t_, t_end_, t_turn_;
+  double r0_, b_, l_;  // |o|, o.d, closest approach of the line to the centre
   std::size_t shell_;
   bool inbound_;
   bool done_ = false;
