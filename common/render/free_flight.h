@@ -11,7 +11,9 @@
 // previous collision (the medium's coefficients are in `point`), and returns
 // whether to go on; then a fresh tau* is drawn.  The returned value is T_maj
 // from the last collision (or the start) to the end of the walk; 1 when the
-// callback stopped the walk.
+// callback stopped the walk.  `majorant_scale` >= 1 inflates the majorants
+// (still bounds, so still unbiased) to place more tentative collisions on a
+// ray, e.g. where each one gathers sunlight (volume_path_integrator.cpp).
 #pragma once
 #include <cmath>
 
@@ -27,14 +29,14 @@ template <class Callback>
 SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, double t_begin, double t_end,
                              const SampledWavelengths& lambda,
                              const std::array<std::size_t, kWavelengthsPerPath>& bins, Sampler& sampler,
-                             MediumPoint& point, Callback&& callback) {
+                             MediumPoint& point, Callback&& callback, double majorant_scale = 1.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
   double tau_target = -std::log1p(-sampler.next());
   ShellTraversal walk(ray, R, medium.shell_bottoms(), t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, bins);
+    const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, bins) * majorant_scale;
     double t = segment.t0;
     while (true) {
       const double tau_rest = sigma_maj[0] * (segment.t1 - t);
@@ -54,6 +56,18 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, dou
     }
   }
   return exp_neg(tau_maj);
+}
+
+// The majorant optical depth of [t_begin, t_end] at each of the path's
+// wavelengths: the expected number of tentative collisions there.
+inline SampledSpectrum majorant_optical_depth(const AtmosphereMedium& medium, const Ray& ray, double t_begin,
+                                              double t_end,
+                                              const std::array<std::size_t, kWavelengthsPerPath>& bins) {
+  ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), medium.shell_bottoms(), t_begin, t_end);
+  ShellSegment segment;
+  SampledSpectrum tau(0.0);
+  while (walk.next(&segment)) tau += medium.sigma_maj(segment.shell, bins) * (segment.t1 - segment.t0);
+  return tau;
 }
 
 }  // namespace skyfarm

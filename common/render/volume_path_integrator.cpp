@@ -71,6 +71,19 @@ struct VolumePathIntegrator::Vertex {
 VolumePathIntegrator::VolumePathIntegrator(const Scene& scene, IntegratorOptions options)
     : scene_(scene), options_(options) {}
 
+// The inflation must not depend on which wavelength is the hero: spectral MIS
+// weighs each wavelength by the pdf its own hero technique would have had, so
+// all four techniques must use the same majorants.  It is therefore set from
+// the largest majorant optical depth of the path's wavelengths.
+double VolumePathIntegrator::camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
+                                                  const std::array<std::size_t, kWavelengthsPerPath>& bins) const {
+  if (options_.max_camera_majorant_scale <= 1.0) return 1.0;
+  const double tau = majorant_optical_depth(scene_.medium(), ray, t_begin, t_end, bins).max();
+  if (tau * options_.max_camera_majorant_scale <= options_.camera_target_collisions)
+    return options_.max_camera_majorant_scale;
+  return std::max(1.0, options_.camera_target_collisions / tau);
+}
+
 SampledSpectrum VolumePathIntegrator::radiance(const Ray& ray, const SampledWavelengths& lambda, Sampler& sampler,
                                                PathCounters* counters) const {
   const SampledSpectrum L = radiance_unchecked(ray, lambda, sampler, counters);
@@ -109,6 +122,17 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             ++counters->collisions;
             const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
             const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
+            // The sun gathered here in expectation: P_s times the NEE of the
+            // real-scattering branch (throughput and r_u of that branch).
+            if (scene_.sun_enabled && p_scatter > 0.0) {
+              const double pdf = T_maj_seg[0] * mp.sigma_s[0];
+              const SampledSpectrum beta_s = beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              const SampledSpectrum r_u_s = r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              if (!beta_s.is_zero() && !r_u_s.is_zero()) {
+                Vertex v{p, ray.d, false, {}, &mp, &phases, beta_s * p_scatter, r_u_s};
+                L += sample_sun(v, lambda, sampler, counters);
+              }
+            }
             const double u = sampler.next();
             if (u < p_absorb) {
               absorbed = true;
@@ -123,8 +147,6 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
                 absorbed = true;
                 return false;
               }
-              Vertex v{p, ray.d, false, {}, &mp, &phases, beta, r_u};
-              if (scene_.sun_enabled) L += sample_sun(v, lambda, sampler, counters);
               // Continue along a direction from the mixture phase function:
               // pick a constituent by its share of sigma_s at the hero
               // wavelength, then sample its phase function.
@@ -164,7 +186,8 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
             r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
             return !beta.is_zero() && !r_u.is_zero();
-          });
+          },
+          depth == 0 ? camera_majorant_scale(ray, extent.t_begin, extent.t_end, bins) : 1.0);
       if (absorbed || beta.is_zero()) return L;
       if (!scattered) {
         const double T0 = T_maj[0];

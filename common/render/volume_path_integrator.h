@@ -13,6 +13,18 @@
 // heuristic) where both can reach the sun; multiple scattering of any order
 // with Russian roulette on the throughput; Lambertian ground.
 //
+// Next-event estimation in expectation: in the medium, the sun is sampled at
+// EVERY tentative collision, weighted by the probability P_s = sigma_s/sigma_maj
+// (hero) that delta tracking would have made it a real scattering there,
+// instead of only at the collisions it does choose to scatter at.  The
+// expectation is the same (the choice's indicator replaced by its
+// probability), the variance far lower in thin skies where most camera rays
+// would otherwise cross the whole atmosphere without scattering.  Camera
+// rays in thin air also inflate their majorants so that they gather the sun
+// at about one point on average (measured: 2-3x the efficiency for zenith
+// views at noon and at sunset; no inflation for long, dense lines of sight
+// where it only costs).
+//
 // Options:
 //   max_depth         hard cap on scattering events (a cost bound; hits are
 //                     counted in PathCounters::depth_limit so tests keep it 0)
@@ -30,6 +42,11 @@ namespace skyfarm {
 struct IntegratorOptions {
   int max_depth = 10000;
   int rr_start_depth = 2;
+  // Camera rays whose majorants promise fewer than this many tentative
+  // collisions inflate them (up to max_camera_majorant_scale) so that each
+  // gathers the sun in expectation at about this many points (see the .cpp).
+  double camera_target_collisions = 1.0;
+  double max_camera_majorant_scale = 8.0;
 };
 
 // Counters a renderer sums over its paths.
@@ -68,6 +85,8 @@ class VolumePathIntegrator {
   struct Vertex;
   SampledSpectrum radiance_unchecked(Ray ray, const SampledWavelengths& lambda, Sampler& sampler,
                                      PathCounters* counters) const;
+  double camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
+                               const std::array<std::size_t, kWavelengthsPerPath>& bins) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
                              PathCounters* counters) const;
 
