@@ -1,6 +1,8 @@
 // skyfarm-worker: the worker side of skyfarm.
 //   skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]
 //   skyfarm-worker probe PROBE.json|- [--threads N]
+//   skyfarm-worker demo [DIR]
+//   skyfarm-worker bench [paths|demo|memory|all] [--repeat N]
 //   skyfarm-worker info REQUEST.json [--json]   the request's sun and optical depths
 //   skyfarm-worker --help | --version
 // The farm worker loop (`--connect`) arrives with the server (issue 4).
@@ -13,6 +15,7 @@
 
 #include "api/field_error.h"
 #include "api/render_request.h"
+#include "worker/bench_command.h"
 #include "worker/cli_io.h"
 #include "worker/render_command.h"
 #include "worker/sky_report.h"
@@ -27,6 +30,10 @@ constexpr const char* kUsage =
     "                                render a request on this machine (all cores by default)\n"
     "  probe PROBE.json [--threads N] spectral radiance in given directions, JSON on stdout\n"
     "                                (PROBE.json may be '-' for standard input)\n"
+    "  demo [DIR]                    render the demo skies (a sunset equirect, a noon fisheye)\n"
+    "                                to DIR/*.exr and *.png (DIR defaults to skyfarm-demo)\n"
+    "  bench [paths|demo|memory|all] [--repeat N]\n"
+    "                                the renderer's benchmarks, JSON lines on stdout\n"
     "  info REQUEST.json [--json]   sun position and optical depths of a render request\n"
     "                                (REQUEST.json may be '-' for standard input)\n"
     "\n"
@@ -87,6 +94,8 @@ int main(int argc, char** argv) {
   if (command == "info") return run_info(args);
   if (command == "render") return skyfarm::run_render_command(args);
   if (command == "probe") return skyfarm::run_probe_command(args);
+  if (command == "bench") return skyfarm::run_bench_command(args);
+  if (command == "demo") return skyfarm::run_demo_command(args);
   std::cerr << "skyfarm-worker: unknown command '" << command << "'\n" << kUsage;
   return 2;
 }

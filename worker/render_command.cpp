@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <algorithm>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "common/render/parallel.h"
 #include "common/render/radiance_probe.h"
 #include "worker/cli_io.h"
+#include "worker/demo_requests.h"
 
 namespace skyfarm {
 namespace {
@@ -72,6 +74,62 @@ void set_metadata(Image* image, const api::RenderRequest& request, const Scene& 
 
 }  // namespace
 
+int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
+                    int threads, const std::string& label) {
+  if (request.method == api::Method::kLut) {
+    std::cerr << "skyfarm-worker render: method \"lut\" is not available yet; use \"path\"\n";
+    return 2;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
+                                        request.spectral.min_nm, request.spectral.max_nm);
+  const Camera camera(request.camera, scene.observer());
+  const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                                           request.spectral.max_nm, request.spectral.batches,
+                                           request.quality.samples_per_pixel, request.seed);
+  const TileRenderer renderer(scene, camera, plan);
+  ImageLayers layers;
+  if (request.output.spectral_channels)
+    layers.spectral = SpectralLayout{plan.lambda_min_nm, plan.lambda_max_nm, plan.batches};
+  layers.relative_error = request.output.error_layer;
+  Image image(plan.width, plan.height, layers);
+  std::fprintf(stderr, "%s: %dx%d, %d spp, %d batches, %d tiles, sun at zenith %.3f deg azimuth %.3f deg\n",
+               label.c_str(), plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
+               scene.sun().zenith_deg(), scene.sun().azimuth_deg());
+  ProgressDisplay progress(label);
+  const LocalRenderResult result =
+      render_image(renderer, &image, threads, [&](int done, int total) { progress.update(done, total); });
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  set_metadata(&image, request, scene, plan, result.estimated_relative_rms);
+
+  ExrWriteOptions exr;
+  exr.half = request.output.half;
+  exr.spectral_channels = request.output.spectral_channels;
+  exr.error_layer = request.output.error_layer;
+  exr.latlong_envmap = request.camera.projection == Projection::kEquirectangular;
+  const ExrWriteReport exr_report = write_exr(image, exr_path, exr);
+  std::printf("wrote %s\n", exr_path.c_str());
+  if (exr_report.clamped_half_values > 0)
+    std::printf("note: %zu values above the half-float range (65504, e.g. the sun disk) were clamped; "
+                "set \"output\": {\"half\": false} to keep them\n",
+                exr_report.clamped_half_values);
+  if (!png_path.empty()) {
+    PngWriteOptions png;
+    png.exposure_ev = request.output.exposure_ev;
+    const PngWriteReport r = write_png(image, png_path, png);
+    std::printf("wrote %s (exposure EV100 %.2f)\n", png_path.c_str(), r.exposure_ev);
+  }
+  const double paths = static_cast<double>(result.counters.paths);
+  std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f\n",
+              seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(threads),
+              result.estimated_relative_rms);
+  if (result.counters.nonfinite > 0)
+    std::printf("warning: %llu non-finite or negative path results were discarded\n",
+                static_cast<unsigned long long>(result.counters.nonfinite));
+  return 0;
+}
+
 int run_render_command(const std::vector<std::string>& args) {
   RenderArgs a;
   if (const std::string err = parse_render_args(args, &a); !err.empty()) {
@@ -86,58 +144,7 @@ int run_render_command(const std::vector<std::string>& args) {
   }
   try {
     const api::RenderRequest request = api::parse_render_request(text);
-    if (request.method == api::Method::kLut) {
-      std::cerr << "skyfarm-worker render: method \"lut\" is not available yet; use \"path\"\n";
-      return 2;
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
-                                          request.spectral.min_nm, request.spectral.max_nm);
-    const Camera camera(request.camera, scene.observer());
-    const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                                             request.spectral.max_nm, request.spectral.batches,
-                                             request.quality.samples_per_pixel, request.seed);
-    const TileRenderer renderer(scene, camera, plan);
-    ImageLayers layers;
-    if (request.output.spectral_channels)
-      layers.spectral = SpectralLayout{plan.lambda_min_nm, plan.lambda_max_nm, plan.batches};
-    layers.relative_error = request.output.error_layer;
-    Image image(plan.width, plan.height, layers);
-    std::fprintf(stderr, "rendering %dx%d, %d spp, %d batches, %d tiles, sun at zenith %.3f deg azimuth %.3f deg\n",
-                 plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
-                 scene.sun().zenith_deg(), scene.sun().azimuth_deg());
-    ProgressDisplay progress("render");
-    const LocalRenderResult result =
-        render_image(renderer, &image, a.threads, [&](int done, int total) { progress.update(done, total); });
-    progress.finish();
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    set_metadata(&image, request, scene, plan, result.estimated_relative_rms);
-
-    ExrWriteOptions exr;
-    exr.half = request.output.half;
-    exr.spectral_channels = request.output.spectral_channels;
-    exr.error_layer = request.output.error_layer;
-    exr.latlong_envmap = request.camera.projection == Projection::kEquirectangular;
-    const ExrWriteReport exr_report = write_exr(image, a.exr, exr);
-    std::printf("wrote %s\n", a.exr.c_str());
-    if (exr_report.clamped_half_values > 0)
-      std::printf("note: %zu values above the half-float range (65504, e.g. the sun disk) were clamped; "
-                  "set \"output\": {\"half\": false} to keep them\n",
-                  exr_report.clamped_half_values);
-    if (!a.png.empty()) {
-      PngWriteOptions png;
-      png.exposure_ev = request.output.exposure_ev;
-      const PngWriteReport r = write_png(image, a.png, png);
-      std::printf("wrote %s (exposure EV100 %.2f)\n", a.png.c_str(), r.exposure_ev);
-    }
-    const double paths = static_cast<double>(result.counters.paths);
-    std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g samples/s per thread), estimated relative RMS error %.4f\n",
-                seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(a.threads),
-                result.estimated_relative_rms);
-    if (result.counters.nonfinite > 0)
-      std::printf("warning: %llu non-finite or negative path results were discarded\n",
-                  static_cast<unsigned long long>(result.counters.nonfinite));
-    return 0;
+    return render_to_files(request, a.exr, a.png, a.threads, "render");
   } catch (const api::ValidationError& e) {
     std::cerr << a.request << ": invalid request\n" << e.what() << "\n";
     return 2;
@@ -145,6 +152,28 @@ int run_render_command(const std::vector<std::string>& args) {
     std::cerr << "skyfarm-worker render: " << e.what() << "\n";
     return 1;
   }
+}
+
+int run_demo_command(const std::vector<std::string>& args) {
+  const std::filesystem::path dir = args.empty() ? std::filesystem::path("skyfarm-demo") : std::filesystem::path(args[0]);
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    std::cerr << "skyfarm-worker demo: cannot create " << dir << ": " << ec.message() << "\n";
+    return 1;
+  }
+  try {
+    for (const auto& demo : demo_requests()) {
+      const api::RenderRequest request = api::parse_render_request(demo.json);
+      const int rc = render_to_files(request, (dir / (demo.name + ".exr")).string(),
+                                     (dir / (demo.name + ".png")).string(), 0, demo.name);
+      if (rc != 0) return rc;
+    }
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-worker demo: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
 }
 
 int run_probe_command(const std::vector<std::string>& args) {

@@ -7,6 +7,8 @@
 namespace skyfarm {
 
 int run_render_command(const std::vector<std::string>& args);
+// skyfarm-worker demo [DIR]: the README's demo skies to DIR/*.exr and *.png.
+int run_demo_command(const std::vector<std::string>& args);
 int run_probe_command(const std::vector<std::string>& args);
 
 }  // namespace skyfarm
