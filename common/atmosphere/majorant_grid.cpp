@@ -6,18 +6,22 @@
 
 namespace skyfarm {
 
-std::vector<double> majorant_shell_boundaries(double top) {
+std::vector<double> majorant_shell_boundaries(double top, double step) {
   std::vector<double> b{0.0};
   while (b.back() < top) {
     const double h = b.back();
     const double dh = h < 2000.0 ? 200.0 : std::min(10000.0, 0.1 * h);
-    b.push_back(std::min(top, h + dh));
+    double next = std::min(top, h + dh);
+    // Snap to the altitude grid (at least one step up).
+    if (step > 0.0 && next < top) next = std::min(top, std::max(h + step, std::round(next / step) * step));
+    b.push_back(next);
   }
   return b;
 }
 
-MajorantGrid::MajorantGrid(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm, double bin_nm)
-    : shell_bottoms_(majorant_shell_boundaries(atmosphere.top_altitude_m())),
+MajorantGrid::MajorantGrid(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm, double bin_nm,
+                           double altitude_step_m)
+    : shell_bottoms_(majorant_shell_boundaries(atmosphere.top_altitude_m(), altitude_step_m)),
       lambda_min_(lambda_min_nm),
       lambda_max_(lambda_max_nm) {
   if (!(lambda_max_nm > lambda_min_nm) || !(bin_nm > 0.0))

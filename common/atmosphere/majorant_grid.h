@@ -21,7 +21,11 @@ namespace skyfarm {
 
 class MajorantGrid {
  public:
-  MajorantGrid(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm, double bin_nm = 1.0);
+  // altitude_step_m > 0 puts every shell boundary on a multiple of it (and the
+  // top), so that coefficients tabulated on that altitude grid and
+  // interpolated linearly stay under the shell's bound (render/atmosphere_medium.h).
+  MajorantGrid(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm, double bin_nm = 1.0,
+               double altitude_step_m = 0.0);
 
   std::size_t shell_count() const { return shell_bottoms_.size() - 1; }
   std::size_t bin_count() const { return bins_; }
@@ -38,6 +42,7 @@ class MajorantGrid {
     return sigma_maj(shell_of(altitude_m), bin_of(lambda_nm));
   }
 
+  double bin_width_nm() const { return bin_width_; }
   double lambda_min_nm() const { return lambda_min_; }
   double lambda_max_nm() const { return lambda_max_; }
 
@@ -49,6 +54,6 @@ class MajorantGrid {
 };
 
 // The shell boundaries used by MajorantGrid for an atmosphere of this top.
-std::vector<double> majorant_shell_boundaries(double top_altitude_m);
+std::vector<double> majorant_shell_boundaries(double top_altitude_m, double altitude_step_m = 0.0);
 
 }  // namespace skyfarm

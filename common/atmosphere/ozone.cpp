@@ -10,7 +10,7 @@
 namespace skyfarm::ozone {
 namespace {
 
-constexpr std::array<double, 5> kTemperatures_K = {203.0, 223.0, 243.0, 273.0, 293.0};
+constexpr const std::array<double, 5>& kTemperatures_K = kTableTemperatures_K;
 constexpr std::array<const char*, 5> kColumns = {"sigma_203K_cm2", "sigma_223K_cm2", "sigma_243K_cm2",
                                                  "sigma_273K_cm2", "sigma_293K_cm2"};
 
@@ -37,6 +37,8 @@ const std::array<PiecewiseLinear, 5>& cross_sections() {
   return tables;
 }
 
+}  // namespace
+
 // Index k and weight t such that T lies between kTemperatures_K[k] and [k+1].
 void temperature_bracket(double T, std::size_t* k, double* t) {
   if (T <= kTemperatures_K.front()) { *k = 0; *t = 0.0; return; }
@@ -47,7 +49,8 @@ void temperature_bracket(double T, std::size_t* k, double* t) {
   *t = (T - kTemperatures_K[i]) / (kTemperatures_K[i + 1] - kTemperatures_K[i]);
 }
 
-}  // namespace
+
+double column_cross_section_m2(double lambda_nm, std::size_t column) { return cross_sections()[column](lambda_nm); }
 
 double cross_section_m2(double lambda_nm, double temperature_K) {
   std::size_t k = 0;

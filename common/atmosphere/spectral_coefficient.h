@@ -34,6 +34,9 @@ class SpectralCoefficient {
   bool is_zero() const;
   // True when the value does not depend on altitude.
   bool altitude_independent() const;
+  // True for the ozone kind (the only one that depends on altitude, through
+  // the US76 temperature; see ozone.h for its temperature columns).
+  bool is_ozone() const { return !altitude_independent(); }
 
  private:
   struct Zero {};

@@ -1,10 +1,35 @@
 #include "common/render/atmosphere_medium.h"
 
+#include <cmath>
 #include <stdexcept>
 
+#include "common/atmosphere/ozone.h"
 #include "common/atmosphere/rayleigh.h"
+#include "common/atmosphere/us76.h"
 
 namespace skyfarm {
+namespace {
+
+// The altitude grid: top / N with N = ceil(top / 25 m), at most 40000 steps.
+double altitude_step_for(double top) {
+  const double n = std::min(40000.0, std::ceil(top / 25.0));
+  return top / n;
+}
+
+// Sub-steps of a majorant bin in the wavelength tables.
+constexpr int kWavelengthStepsPerBin = 16;
+
+}  // namespace
+
+UniformTable::UniformTable(double x0, double x1, int n, const std::function<double(double)>& f)
+    : x0_(x0), inv_step_(n > 1 ? (n - 1) / (x1 - x0) : 1.0) {
+  v_.resize(static_cast<std::size_t>(std::max(n, 1)));
+  for (int i = 0; i < n; ++i) {
+    // The last knot is x1 exactly (no round-off drift).
+    const double x = (i + 1 == n) ? x1 : x0 + (x1 - x0) * i / std::max(n - 1, 1);
+    v_[static_cast<std::size_t>(i)] = f(x);
+  }
+}
 
 double PathPhases::eval(int s, int i, double mu) const {
   const Entry& e = entries_[static_cast<std::size_t>(s)];
@@ -17,15 +42,36 @@ double PathPhases::sample_cos_theta(int s, double u) const {
 }
 
 AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm)
-    : atmosphere_(atmosphere), majorants_(atmosphere, lambda_min_nm, lambda_max_nm) {
+    : atmosphere_(atmosphere),
+      altitude_step_(altitude_step_for(atmosphere.top_altitude_m())),
+      majorants_(atmosphere, lambda_min_nm, lambda_max_nm, 1.0, altitude_step_) {
   for (std::size_t i = 0; i <= majorants_.shell_count(); ++i) shell_bottoms_.push_back(majorants_.shell_bottom(i));
   const auto& cs = atmosphere_.constituents();
+  if (cs.size() > static_cast<std::size_t>(kMaxConstituents))
+    throw std::invalid_argument("atmosphere: at most 16 constituents");
+  const double top = atmosphere_.top_altitude_m();
+  const int n_h = static_cast<int>(std::lround(top / altitude_step_)) + 1;
+  const double l0 = majorants_.lambda_min_nm(), l1 = majorants_.lambda_max_nm();
+  const int n_l = static_cast<int>(majorants_.bin_count()) * kWavelengthStepsPerBin + 1;
+  bool any_ozone = false;
   for (std::size_t c = 0; c < cs.size(); ++c) {
-    if (cs[c].scatters()) scatterers_.push_back(static_cast<int>(c));
-    if (cs[c].absorbs()) absorbers_.push_back(static_cast<int>(c));
+    const Constituent& con = cs[c];
+    Tables t;
+    t.rho = UniformTable(0.0, top, n_h, [&](double h) { return con.density.eval(h); });
+    t.k_s = UniformTable(l0, l1, n_l, [&](double l) { return con.k_scattering.eval(l, 0.0); });
+    t.ozone = con.k_absorption.is_ozone();
+    if (t.ozone) {
+      any_ozone = true;
+      for (std::size_t k = 0; k < 5; ++k)
+        t.k_a_columns[k] = UniformTable(l0, l1, n_l, [&](double l) { return ozone::column_cross_section_m2(l, k); });
+    } else {
+      t.k_a = UniformTable(l0, l1, n_l, [&](double l) { return con.k_absorption.eval(l, 0.0); });
+    }
+    tables_.push_back(std::move(t));
+    if (con.scatters()) scatterers_.push_back(static_cast<int>(c));
+    if (con.absorbs()) absorbers_.push_back(static_cast<int>(c));
   }
-  if (scatterers_.size() > static_cast<std::size_t>(kMaxScatterers))
-    throw std::invalid_argument("atmosphere: at most 16 scattering constituents");
+  if (any_ozone) temperature_ = UniformTable(0.0, top, n_h, us76::temperature_K);
 }
 
 const std::string& AtmosphereMedium::scatterer_name(int s) const {
@@ -45,25 +91,48 @@ SampledSpectrum AtmosphereMedium::sigma_maj(std::size_t shell,
   return m;
 }
 
-void AtmosphereMedium::point(double h, const SampledWavelengths& lambda, MediumPoint* out) const {
+PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& lambda) const {
+  PathCoefficients pc;
+  pc.bins = bins(lambda);
+  for (std::size_t c = 0; c < tables_.size(); ++c) {
+    const Tables& t = tables_[c];
+    for (int i = 0; i < kWavelengthsPerPath; ++i) {
+      const double l = lambda.lambda_nm[static_cast<std::size_t>(i)];
+      pc.k_s[c][i] = t.k_s.eval(l);
+      if (t.ozone) {
+        for (std::size_t k = 0; k < 5; ++k) pc.k_a_columns[c][k][i] = t.k_a_columns[k].eval(l);
+      } else {
+        pc.k_a[c][i] = t.k_a.eval(l);
+      }
+    }
+  }
+  return pc;
+}
+
+void AtmosphereMedium::point(double h, const PathCoefficients& pc, MediumPoint* out) const {
   out->sigma_a = SampledSpectrum(0.0);
   out->sigma_s = SampledSpectrum(0.0);
   if (h > atmosphere_.top_altitude_m()) {
     for (std::size_t s = 0; s < scatterers_.size(); ++s) out->sigma_s_c[s] = SampledSpectrum(0.0);
     return;
   }
-  const auto& cs = atmosphere_.constituents();
+  h = std::max(h, 0.0);
   for (std::size_t s = 0; s < scatterers_.size(); ++s) {
-    const Constituent& c = cs[static_cast<std::size_t>(scatterers_[s])];
-    const double rho = c.density.eval(h);
-    SampledSpectrum& sc = out->sigma_s_c[s];
-    for (int i = 0; i < kWavelengthsPerPath; ++i) sc[i] = rho * c.k_scattering.eval(lambda.lambda_nm[i], h);
-    out->sigma_s += sc;
+    const auto c = static_cast<std::size_t>(scatterers_[s]);
+    out->sigma_s_c[s] = pc.k_s[c] * tables_[c].rho.eval(h);
+    out->sigma_s += out->sigma_s_c[s];
   }
   for (int a : absorbers_) {
-    const Constituent& c = cs[static_cast<std::size_t>(a)];
-    const double rho = c.density.eval(h);
-    for (int i = 0; i < kWavelengthsPerPath; ++i) out->sigma_a[i] += rho * c.k_absorption.eval(lambda.lambda_nm[i], h);
+    const auto c = static_cast<std::size_t>(a);
+    const double rho = tables_[c].rho.eval(h);
+    if (tables_[c].ozone) {
+      std::size_t k = 0;
+      double t = 0.0;
+      ozone::temperature_bracket(temperature_.eval(h), &k, &t);
+      out->sigma_a += (pc.k_a_columns[c][k] * (1.0 - t) + pc.k_a_columns[c][k + 1] * t) * rho;
+    } else {
+      out->sigma_a += pc.k_a[c] * rho;
+    }
   }
 }
 
@@ -77,7 +146,7 @@ PathPhases AtmosphereMedium::phases(const SampledWavelengths& lambda) const {
     if (c.rayleigh_depolarization_from_bucholtz) {
       e.shared = nullptr;
       for (int i = 0; i < kWavelengthsPerPath; ++i) {
-        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[i]);
+        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[static_cast<std::size_t>(i)]);
         e.rayleigh[static_cast<std::size_t>(i)] = RayleighPhase{rho_n, rho_n / (2.0 - rho_n)};
       }
     } else {

@@ -27,16 +27,15 @@ namespace skyfarm {
 
 template <class Callback>
 SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, double t_begin, double t_end,
-                             const SampledWavelengths& lambda,
-                             const std::array<std::size_t, kWavelengthsPerPath>& bins, Sampler& sampler,
-                             MediumPoint& point, Callback&& callback, double majorant_scale = 1.0) {
+                             const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
+                             Callback&& callback, double majorant_scale = 1.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
   double tau_target = -std::log1p(-sampler.next());
   ShellTraversal walk(ray, R, medium.shell_bottoms(), t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, bins) * majorant_scale;
+    const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, path.bins) * majorant_scale;
     double t = segment.t0;
     while (true) {
       const double tau_rest = sigma_maj[0] * (segment.t1 - t);
@@ -49,7 +48,7 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, dou
       t += dt;
       tau_maj += sigma_maj * dt;
       const glm::dvec3 p = ray.at(t);
-      medium.point(glm::length(p) - R, lambda, &point);
+      medium.point(glm::length(p) - R, path, &point);
       if (!callback(t, p, sigma_maj, exp_neg(tau_maj))) return SampledSpectrum(1.0);
       tau_maj = SampledSpectrum(0.0);
       tau_target = -std::log1p(-sampler.next());

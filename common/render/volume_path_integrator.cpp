@@ -65,6 +65,7 @@ struct VolumePathIntegrator::Vertex {
   glm::dvec3 n;               // ground normal
   const MediumPoint* medium = nullptr;
   const PathPhases* phases = nullptr;
+  const PathCoefficients* path = nullptr;
   SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
 };
 
@@ -103,7 +104,8 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
   const AtmosphereMedium& medium = scene_.medium();
   const Atmosphere& atmosphere = scene_.atmosphere();
   const Sun& sun = scene_.sun();
-  const auto bins = medium.bins(lambda);
+  const PathCoefficients path = medium.path_coefficients(lambda);
+  const auto& bins = path.bins;
   const PathPhases phases = medium.phases(lambda);
 
   SampledSpectrum L(0.0), beta(1.0), r_u(1.0), r_l(1.0);
@@ -117,7 +119,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
       const SampledSpectrum T_maj = sample_t_maj(
-          medium, ray, extent.t_begin, extent.t_end, lambda, bins, sampler, mp,
+          medium, ray, extent.t_begin, extent.t_end, path, sampler, mp,
           [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
             ++counters->collisions;
             const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
@@ -129,7 +131,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
               const SampledSpectrum beta_s = beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
               const SampledSpectrum r_u_s = r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
               if (!beta_s.is_zero() && !r_u_s.is_zero()) {
-                Vertex v{p, ray.d, false, {}, &mp, &phases, beta_s * p_scatter, r_u_s};
+                Vertex v{p, ray.d, false, {}, &mp, &phases, &path, beta_s * p_scatter, r_u_s};
                 L += sample_sun(v, lambda, sampler, counters);
               }
             }
@@ -202,7 +204,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
         // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
         const glm::dvec3 n = glm::normalize(ray.at(extent.t_end));
         const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
-        Vertex v{p, ray.d, true, n, nullptr, nullptr, beta, r_u};
+        Vertex v{p, ray.d, true, n, nullptr, nullptr, &path, beta, r_u};
         if (scene_.sun_enabled) L += sample_sun(v, lambda, sampler, counters);
         double pdf = 0.0;
         const glm::dvec3 wi = atmosphere.ground().sample_direction(n, sampler.next(), sampler.next(), &pdf);
@@ -281,7 +283,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     const AtmosphereMedium& medium = scene_.medium();
     MediumPoint mp;
     const SampledSpectrum T_maj = sample_t_maj(
-        medium, shadow, std::max(0.0, top.t_near), top.t_far, lambda, medium.bins(lambda), sampler, mp,
+        medium, shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, mp,
         [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
           ++counters->collisions;
           const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
@@ -326,7 +328,7 @@ SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end
   MediumPoint mp;
   SampledSpectrum T_ray(1.0);
   const SampledSpectrum T_maj = sample_t_maj(
-      medium, ray, t0, t1, lambda, medium.bins(lambda), sampler, mp,
+      medium, ray, t0, t1, medium.path_coefficients(lambda), sampler, mp,
       [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
         ++counters->collisions;
         // Ratio tracking: T *= sigma_n / sigma_maj (hero), times the other
