@@ -6,6 +6,7 @@
 #include "common/atmosphere/ozone.h"
 #include "common/atmosphere/rayleigh.h"
 #include "common/atmosphere/us76.h"
+#include "common/sun/sun.h"
 
 namespace skyfarm {
 namespace {
@@ -45,7 +46,7 @@ AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_m
     : atmosphere_(atmosphere),
       altitude_step_(altitude_step_for(atmosphere.top_altitude_m())),
       majorants_(atmosphere, lambda_min_nm, lambda_max_nm, 1.0, altitude_step_) {
-  for (std::size_t i = 0; i <= majorants_.shell_count(); ++i) shell_bottoms_.push_back(majorants_.shell_bottom(i));
+  build_shells();
   const auto& cs = atmosphere_.constituents();
   if (cs.size() > static_cast<std::size_t>(kMaxConstituents))
     throw std::invalid_argument("atmosphere: at most 16 constituents");
@@ -84,16 +85,44 @@ std::array<std::size_t, kWavelengthsPerPath> AtmosphereMedium::bins(const Sample
   return b;
 }
 
-SampledSpectrum AtmosphereMedium::sigma_maj(std::size_t shell,
-                                            const std::array<std::size_t, kWavelengthsPerPath>& bins) const {
-  SampledSpectrum m;
-  for (int i = 0; i < kWavelengthsPerPath; ++i) m[i] = majorants_.sigma_maj(shell, bins[i]) * (1.0 + 1e-9);
-  return m;
+// Fine shells: the MajorantGrid's.  Coarse shells: the fine boundaries
+// nearest 0, 1, 2, 5, 10, 20, 40, 70 km and the top, each bound the max of
+// the fine bounds inside it.
+void AtmosphereMedium::build_shells() {
+  const std::size_t bins = majorants_.bin_count();
+  fine_.bins = coarse_.bins = bins;
+  for (std::size_t i = 0; i <= majorants_.shell_count(); ++i) fine_.bottoms.push_back(majorants_.shell_bottom(i));
+  for (std::size_t i = 0; i < majorants_.shell_count(); ++i)
+    for (std::size_t j = 0; j < bins; ++j) fine_.table.push_back(majorants_.sigma_maj(i, j) * (1.0 + 1e-9));
+
+  std::vector<std::size_t> cuts{0};
+  for (double target : {1000.0, 2000.0, 5000.0, 10000.0, 20000.0, 40000.0, 70000.0}) {
+    std::size_t best = cuts.back();
+    for (std::size_t i = cuts.back() + 1; i < fine_.shell_count(); ++i)
+      if (std::abs(fine_.bottoms[i] - target) < std::abs(fine_.bottoms[best] - target) || best == cuts.back())
+        best = i;
+    if (best > cuts.back() && best < fine_.shell_count()) cuts.push_back(best);
+  }
+  cuts.push_back(fine_.shell_count());
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
+    coarse_.bottoms.push_back(fine_.bottoms[cuts[c]]);
+    for (std::size_t j = 0; j < bins; ++j) {
+      double m = 0.0;
+      for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) m = std::max(m, fine_.table[i * bins + j]);
+      coarse_.table.push_back(m);
+    }
+  }
+  coarse_.bottoms.push_back(fine_.bottoms.back());
 }
 
-PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& lambda) const {
+PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& lambda, const Sun* sun) const {
   PathCoefficients pc;
   pc.bins = bins(lambda);
+  for (int i = 0; i < kWavelengthsPerPath; ++i) {
+    const double l = lambda.lambda_nm[static_cast<std::size_t>(i)];
+    pc.sun_radiance[i] = sun ? sun->radiance(l) : 0.0;
+    pc.ground_albedo[i] = atmosphere_.ground().albedo(l);
+  }
   for (std::size_t c = 0; c < tables_.size(); ++c) {
     const Tables& t = tables_[c];
     for (int i = 0; i < kWavelengthsPerPath; ++i) {

@@ -24,6 +24,7 @@
 #include "common/atmosphere/atmosphere.h"
 #include "common/atmosphere/majorant_grid.h"
 #include "common/spectrum/sampled_spectrum.h"
+#include "common/sun/sun.h"
 
 namespace skyfarm {
 
@@ -36,11 +37,28 @@ struct MediumPoint {
   std::array<SampledSpectrum, kMaxScatterers> sigma_s_c;  // per scattering constituent
 };
 
-// The wavelength factors of every constituent at the path's wavelengths.
+// The wavelength factors of every constituent at the path's wavelengths,
+// and the other per-wavelength constants of a path.
 struct PathCoefficients {
   std::array<std::size_t, kWavelengthsPerPath> bins{};  // majorant bins
   std::array<SampledSpectrum, kMaxConstituents> k_s, k_a;
   std::array<std::array<SampledSpectrum, 5>, kMaxConstituents> k_a_columns;  // ozone temperature columns
+  SampledSpectrum sun_radiance;   // inside the disk (the irradiance for a point sun)
+  SampledSpectrum ground_albedo;
+};
+
+// One set of majorant shells: boundaries (altitudes, K + 1 values) and
+// sigma_maj per (shell, wavelength bin), inflated by 1e-9 relative.
+struct ShellMajorants {
+  std::vector<double> bottoms;
+  std::vector<double> table;  // shell-major
+  std::size_t bins = 1;
+  std::size_t shell_count() const { return bottoms.size() - 1; }
+  SampledSpectrum sigma_maj(std::size_t shell, const std::array<std::size_t, kWavelengthsPerPath>& b) const {
+    SampledSpectrum m;
+    for (int i = 0; i < kWavelengthsPerPath; ++i) m[i] = table[shell * bins + b[static_cast<std::size_t>(i)]];
+    return m;
+  }
 };
 
 // The phase functions of the scattering constituents at the path's
@@ -88,20 +106,26 @@ class AtmosphereMedium {
 
   const Atmosphere& atmosphere() const { return atmosphere_; }
   const MajorantGrid& majorants() const { return majorants_; }
-  std::span<const double> shell_bottoms() const { return shell_bottoms_; }
+  // Fine shells (tight bounds) for delta tracking of path segments; coarse
+  // shells (a few, each the max of the fine ones it holds) for transmittance:
+  // ratio tracking gains nothing from tight bounds, and every shell crossed
+  // costs a ray/sphere root.
+  const ShellMajorants& fine_shells() const { return fine_; }
+  const ShellMajorants& coarse_shells() const { return coarse_; }
   int scatterer_count() const { return static_cast<int>(scatterers_.size()); }
   const std::string& scatterer_name(int s) const;
   double altitude_step_m() const { return altitude_step_; }
 
   // Majorant-grid bins of the path's wavelengths.
   std::array<std::size_t, kWavelengthsPerPath> bins(const SampledWavelengths& lambda) const;
-  SampledSpectrum sigma_maj(std::size_t shell, const std::array<std::size_t, kWavelengthsPerPath>& bins) const;
-
-  PathCoefficients path_coefficients(const SampledWavelengths& lambda) const;
+  // The per-path constants; `sun` gives the disk radiance.
+  PathCoefficients path_coefficients(const SampledWavelengths& lambda, const Sun* sun = nullptr) const;
   void point(double altitude_m, const PathCoefficients& path, MediumPoint* out) const;
   PathPhases phases(const SampledWavelengths& lambda) const;
 
  private:
+  void build_shells();
+
   struct Tables {
     UniformTable rho;                        // density on the altitude grid
     UniformTable k_s, k_a;                   // per unit density, on the wavelength grid
@@ -112,7 +136,7 @@ class AtmosphereMedium {
   const Atmosphere& atmosphere_;
   double altitude_step_;
   MajorantGrid majorants_;
-  std::vector<double> shell_bottoms_;
+  ShellMajorants fine_, coarse_;
   std::vector<Tables> tables_;   // per constituent
   UniformTable temperature_;     // US76 T(h), for ozone
   std::vector<int> scatterers_;  // constituent indices that scatter

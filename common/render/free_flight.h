@@ -26,16 +26,17 @@
 namespace skyfarm {
 
 template <class Callback>
-SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, double t_begin, double t_end,
+SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorants& shells, const Ray& ray,
+                             double t_begin, double t_end,
                              const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
                              Callback&& callback, double majorant_scale = 1.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
   double tau_target = -std::log1p(-sampler.next());
-  ShellTraversal walk(ray, R, medium.shell_bottoms(), t_begin, t_end);
+  ShellTraversal walk(ray, R, shells.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum sigma_maj = medium.sigma_maj(segment.shell, path.bins) * majorant_scale;
+    const SampledSpectrum sigma_maj = shells.sigma_maj(segment.shell, path.bins) * majorant_scale;
     double t = segment.t0;
     while (true) {
       const double tau_rest = sigma_maj[0] * (segment.t1 - t);
@@ -59,13 +60,13 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const Ray& ray, dou
 
 // The majorant optical depth of [t_begin, t_end] at each of the path's
 // wavelengths: the expected number of tentative collisions there.
-inline SampledSpectrum majorant_optical_depth(const AtmosphereMedium& medium, const Ray& ray, double t_begin,
-                                              double t_end,
+inline SampledSpectrum majorant_optical_depth(const AtmosphereMedium& medium, const ShellMajorants& shells,
+                                              const Ray& ray, double t_begin, double t_end,
                                               const std::array<std::size_t, kWavelengthsPerPath>& bins) {
-  ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), medium.shell_bottoms(), t_begin, t_end);
+  ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), shells.bottoms, t_begin, t_end);
   ShellSegment segment;
   SampledSpectrum tau(0.0);
-  while (walk.next(&segment)) tau += medium.sigma_maj(segment.shell, bins) * (segment.t1 - segment.t0);
+  while (walk.next(&segment)) tau += shells.sigma_maj(segment.shell, bins) * (segment.t1 - segment.t0);
   return tau;
 }
 

@@ -79,7 +79,8 @@ VolumePathIntegrator::VolumePathIntegrator(const Scene& scene, IntegratorOptions
 double VolumePathIntegrator::camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
                                                   const std::array<std::size_t, kWavelengthsPerPath>& bins) const {
   if (options_.max_camera_majorant_scale <= 1.0) return 1.0;
-  const double tau = majorant_optical_depth(scene_.medium(), ray, t_begin, t_end, bins).max();
+  const AtmosphereMedium& medium = scene_.medium();
+  const double tau = majorant_optical_depth(medium, medium.fine_shells(), ray, t_begin, t_end, bins).max();
   if (tau * options_.max_camera_majorant_scale <= options_.camera_target_collisions)
     return options_.max_camera_majorant_scale;
   return std::max(1.0, options_.camera_target_collisions / tau);
@@ -104,7 +105,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
   const AtmosphereMedium& medium = scene_.medium();
   const Atmosphere& atmosphere = scene_.atmosphere();
   const Sun& sun = scene_.sun();
-  const PathCoefficients path = medium.path_coefficients(lambda);
+  const PathCoefficients path = medium.path_coefficients(lambda, &sun);
   const auto& bins = path.bins;
   const PathPhases phases = medium.phases(lambda);
 
@@ -119,7 +120,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
       const SampledSpectrum T_maj = sample_t_maj(
-          medium, ray, extent.t_begin, extent.t_end, path, sampler, mp,
+          medium, medium.fine_shells(), ray, extent.t_begin, extent.t_end, path, sampler, mp,
           [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
             ++counters->collisions;
             const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
@@ -210,14 +211,13 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
         const glm::dvec3 wi = atmosphere.ground().sample_direction(n, sampler.next(), sampler.next(), &pdf);
         if (!(pdf > 0.0)) return L;
         // f cos / pdf = rho for Lambert (pdf = cos / pi).
-        for (int i = 0; i < kWavelengthsPerPath; ++i) beta[i] *= atmosphere.ground().albedo(lambda.lambda_nm[i]);
+        beta *= path.ground_albedo;
         r_l = r_u * (1.0 / pdf);
         ray = Ray{p, wi};
       } else {
         // --- Escaped: the sun disk (with MIS if the last vertex sampled it) and the environment.
         if (scene_.sun_enabled && sun.contains(ray.d)) {
-          SampledSpectrum Le;
-          for (int i = 0; i < kWavelengthsPerPath; ++i) Le[i] = sun.radiance(lambda.lambda_nm[i]);
+          const SampledSpectrum& Le = path.sun_radiance;
           if (!mis_with_sun) {
             L += beta * Le * (1.0 / r_u.average());
           } else {
@@ -252,7 +252,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
 //   L_d = beta f T L_sun / avg_i(r_p,i (pdf_light r_l,ray,i + pdf_scatter,i r_u,ray,i)),
 // balance heuristic between sampling the sun and sampling the phase/BRDF
 // (for a point sun only the former exists).
-SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
+SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledWavelengths&, Sampler& sampler,
                                                  PathCounters* counters) const {
   const Sun& sun = scene_.sun();
   const Atmosphere& atmosphere = scene_.atmosphere();
@@ -265,8 +265,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (v.on_ground) {
     const double cos_theta = glm::dot(v.n, wi);
     if (cos_theta <= 0.0) return SampledSpectrum(0.0);
-    for (int i = 0; i < kWavelengthsPerPath; ++i)
-      f[i] = atmosphere.ground().brdf(lambda.lambda_nm[i], cos_theta) * cos_theta;
+    f = v.path->ground_albedo * (kInvPi * cos_theta);
     pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
@@ -283,7 +282,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     const AtmosphereMedium& medium = scene_.medium();
     MediumPoint mp;
     const SampledSpectrum T_maj = sample_t_maj(
-        medium, shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, mp,
+        medium, medium.coarse_shells(), shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, mp,
         [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
           ++counters->collisions;
           const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
@@ -309,8 +308,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     r_u_ray *= T_maj * (1.0 / T0);
   }
 
-  SampledSpectrum Le;
-  for (int i = 0; i < kWavelengthsPerPath; ++i) Le[i] = sun.radiance(lambda.lambda_nm[i]);
+  const SampledSpectrum& Le = v.path->sun_radiance;
   const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
   const SampledSpectrum Ld = v.beta * f * T_ray * Le;
   if (sun.is_point()) return Ld * (1.0 / r_l.average());
@@ -328,7 +326,7 @@ SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end
   MediumPoint mp;
   SampledSpectrum T_ray(1.0);
   const SampledSpectrum T_maj = sample_t_maj(
-      medium, ray, t0, t1, medium.path_coefficients(lambda), sampler, mp,
+      medium, medium.coarse_shells(), ray, t0, t1, medium.path_coefficients(lambda), sampler, mp,
       [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
         ++counters->collisions;
         // Ratio tracking: T *= sigma_n / sigma_maj (hero), times the other
