@@ -26,7 +26,7 @@ constexpr const char* kUsage =
     "usage: skyfarm-worker <command> [options]\n"
     "\n"
     "commands:\n"
-    "  render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]\n"
+    "  render REQUEST.json -o OUT.exr [--png OUT.png [--png-16bit]] [--threads N]\n"
     "                                render a request on this machine (all cores by default)\n"
     "  probe PROBE.json [--threads N] spectral radiance in given directions, JSON on stdout\n"
     "                                (PROBE.json may be '-' for standard input)\n"

@@ -26,6 +26,7 @@ namespace {
 struct RenderArgs {
   std::string request, exr, png;
   int threads = 0;
+  int png_bits = 8;
 };
 
 // Parses "REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]"; returns an error text or "".
@@ -37,6 +38,8 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
       out->exr = args[++i];
     } else if (a == "--png" && has_value) {
       out->png = args[++i];
+    } else if (a == "--png-16bit") {
+      out->png_bits = 16;
     } else if (a == "--threads" && has_value) {
       try {
         out->threads = std::stoi(args[++i]);
@@ -75,7 +78,7 @@ void set_metadata(Image* image, const api::RenderRequest& request, const Scene& 
 }  // namespace
 
 int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
-                    int threads, const std::string& label) {
+                    int threads, const std::string& label, int png_bits = 8) {
   if (request.method == api::Method::kLut) {
     std::cerr << "skyfarm-worker render: method \"lut\" is not available yet; use \"path\"\n";
     return 2;
@@ -117,6 +120,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   if (!png_path.empty()) {
     PngWriteOptions png;
     png.exposure_ev = request.output.exposure_ev;
+    png.bit_depth = png_bits;
     const PngWriteReport r = write_png(image, png_path, png);
     std::printf("wrote %s (exposure EV100 %.2f)\n", png_path.c_str(), r.exposure_ev);
   }
@@ -134,7 +138,7 @@ int run_render_command(const std::vector<std::string>& args) {
   RenderArgs a;
   if (const std::string err = parse_render_args(args, &a); !err.empty()) {
     std::cerr << "skyfarm-worker render: " << err
-              << "\nusage: skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]\n";
+              << "\nusage: skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png [--png-16bit]] [--threads N]\n";
     return 2;
   }
   std::string text, error;
@@ -144,7 +148,7 @@ int run_render_command(const std::vector<std::string>& args) {
   }
   try {
     const api::RenderRequest request = api::parse_render_request(text);
-    return render_to_files(request, a.exr, a.png, a.threads, "render");
+    return render_to_files(request, a.exr, a.png, a.threads, "render", a.png_bits);
   } catch (const api::ValidationError& e) {
     std::cerr << a.request << ": invalid request\n" << e.what() << "\n";
     return 2;
