@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_request.h"
+#include "api/render_setup.h"
 #include "common/render/local_render.h"
 #include "common/render/parallel.h"
 #include "worker/cli_io.h"
@@ -37,14 +38,9 @@ struct Timed {
 // Renders a parsed request into memory (no files) with `threads` threads.
 Timed render_request(const api::RenderRequest& request, int threads) {
   const auto t0 = std::chrono::steady_clock::now();
-  const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
-                                        request.spectral.min_nm, request.spectral.max_nm);
-  const Camera camera(request.camera, scene.observer());
-  const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                                           request.spectral.max_nm, request.spectral.batches,
-                                           request.quality.samples_per_pixel, request.seed);
-  const TileRenderer renderer(scene, camera, plan);
-  Image image(plan.width, plan.height);
+  const api::RenderSetup setup = api::make_render_setup(request);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  Image image(setup.plan.width, setup.plan.height);
   Timed t;
   t.counters = render_image(renderer, &image, threads).counters;
   t.seconds = seconds_since(t0);

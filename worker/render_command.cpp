@@ -11,6 +11,7 @@
 #include "api/field_error.h"
 #include "api/probe_request.h"
 #include "api/render_request.h"
+#include "api/render_setup.h"
 #include "common/core/constants.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
@@ -84,13 +85,10 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
     return 2;
   }
   const auto t0 = std::chrono::steady_clock::now();
-  const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
-                                        request.spectral.min_nm, request.spectral.max_nm);
-  const Camera camera(request.camera, scene.observer());
-  const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                                           request.spectral.max_nm, request.spectral.batches,
-                                           request.quality.samples_per_pixel, request.seed);
-  const TileRenderer renderer(scene, camera, plan);
+  const api::RenderSetup setup = api::make_render_setup(request);
+  const Scene& scene = *setup.scene;
+  const RenderPlan& plan = setup.plan;
+  const TileRenderer renderer(scene, *setup.camera, plan);
   ImageLayers layers;
   if (request.output.spectral_channels)
     layers.spectral = SpectralLayout{plan.lambda_min_nm, plan.lambda_max_nm, plan.batches};
