@@ -14,3 +14,22 @@ RenderSetup make_render_setup(const RenderRequest& request) {
 }
 
 }  // namespace skyfarm::api
+
+namespace skyfarm::api {
+
+void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
+                         int samples_per_pixel, std::optional<double> estimated_relative_rms) {
+  namespace key = metadata_key;
+  image->set_metadata(key::kRequest, canonical_text(request));
+  image->set_metadata(key::kSunZenithDeg, sun.zenith_deg());
+  image->set_metadata(key::kSunAzimuthDeg, sun.azimuth_deg());
+  image->set_metadata(key::kSamplesPerPixel, static_cast<double>(samples_per_pixel));
+  image->set_metadata(key::kWavelengthMinNm, plan.lambda_min_nm);
+  image->set_metadata(key::kWavelengthMaxNm, plan.lambda_max_nm);
+  image->set_metadata(key::kSoftwareVersion, std::string("skyfarm ") + SKYFARM_VERSION);
+  if (estimated_relative_rms) image->set_metadata(key::kEstimatedRelativeRms, *estimated_relative_rms);
+  image->set_metadata("method", std::string("path"));
+  image->set_metadata("earth_sun_distance_au", sun.distance_au());
+}
+
+}  // namespace skyfarm::api

@@ -7,6 +7,7 @@
 
 #include "api/render_request.h"
 #include "common/camera/camera.h"
+#include "common/film/image.h"
 #include "common/render/render_plan.h"
 #include "common/render/scene.h"
 
@@ -19,5 +20,12 @@ struct RenderSetup {
 };
 
 RenderSetup make_render_setup(const RenderRequest& request);
+
+// The metadata every rendered image carries (EXR attributes, PNG text), the
+// same for `skyfarm-worker render` and the farm so their files are identical:
+// canonical request, sun position, samples, wavelength range, version,
+// method and the estimated error.
+void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
+                         int samples_per_pixel, std::optional<double> estimated_relative_rms);
 
 }  // namespace skyfarm::api

@@ -1,2 +1,649 @@
-// Placeholder translation unit; the implementation lands with issue 4.
 #include "server/job_service.h"
+
+#include <algorithm>
+#include <condition_variable>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+#include <sstream>
+
+#include "api/render_setup.h"
+#include "common/atmosphere/atmosphere_builder.h"
+#include "common/film/film_tile.h"
+#include "common/image/exr_writer.h"
+#include "common/image/png_writer.h"
+#include "common/render/render_plan.h"
+#include "common/sampling/sampler.h"
+#include "server/job_store.h"
+#include "server/tile_merger.h"
+
+namespace skyfarm::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+std::string random_id() {
+  static std::mutex mu;
+  static std::mt19937_64 rng(std::random_device{}() ^ static_cast<std::uint64_t>(unix_now() * 1e6));
+  const std::lock_guard<std::mutex> lock(mu);
+  std::ostringstream o;
+  o << std::hex;
+  o.width(16);
+  o.fill('0');
+  o << rng();
+  return o.str();
+}
+
+// The result-cache key: the canonical request without its priority (which
+// changes when a job runs, not what it renders), hashed.
+std::string request_hash(const api::RenderRequest& request) {
+  nlohmann::json j = api::to_canonical_json(request);
+  j.erase("priority");
+  const std::string text = j.dump();
+  std::uint64_t h1 = 0x9e3779b97f4a7c15ULL, h2 = 0xc2b2ae3d27d4eb4fULL;
+  for (unsigned char c : text) {
+    h1 = fmix64(h1 ^ c);
+    h2 = fmix64(h2 + c * 0x100000001b3ULL);
+  }
+  std::ostringstream o;
+  o << std::hex << h1 << h2;
+  return o.str();
+}
+
+bool is_terminal(const std::string& state) { return state == "done" || state == "failed" || state == "cancelled"; }
+
+// Unit index i of a job, pass-major: every tile and batch of pass 0 first.
+WorkUnit unit_at(const RenderPlan& plan, std::size_t i) {
+  const std::size_t per_pass = static_cast<std::size_t>(plan.tile_count()) * static_cast<std::size_t>(plan.batches);
+  const std::size_t rem = i % per_pass;
+  return WorkUnit{static_cast<int>(rem / static_cast<std::size_t>(plan.batches)),
+                  static_cast<int>(rem % static_cast<std::size_t>(plan.batches)), static_cast<int>(i / per_pass)};
+}
+
+std::string unit_text(const WorkUnit& u) {
+  return "tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) + ", pass " + std::to_string(u.pass);
+}
+
+// What the render includes and leaves out (DESIGN §3.5 "scene plan").
+nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& plan) {
+  nlohmann::json constituents = nlohmann::json::array(), skipped = nlohmann::json::array();
+  const Atmosphere atmosphere = build_atmosphere(request.atmosphere);
+  for (const auto& c : atmosphere.constituents()) constituents.push_back(c.name);
+  if (request.atmosphere.preset != AtmospherePreset::kCustom) {
+    if (request.atmosphere.ozone_du <= 0.0) skipped.push_back("ozone");
+    if (!request.atmosphere.aerosol || request.atmosphere.aerosol->optical_depth_550 <= 0.0)
+      skipped.push_back("aerosol");
+  }
+  return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
+          {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
+          {"tile_size", plan.tile_size},  {"units", plan.unit_count()}};
+}
+
+}  // namespace
+
+// --- One job in memory ------------------------------------------------------
+struct Job {
+  JobRecord record;
+  api::RenderRequest request;
+  RenderPlan plan;
+  nlohmann::json plan_json;
+  std::unique_ptr<TileMerger> merger;
+  std::size_t cursor = 0;               // next never-dispatched unit index (pass-major)
+  std::deque<WorkUnit> requeued;        // units to dispatch again
+  std::map<int, std::set<std::string>> failed_workers;  // by pass-major index
+  int in_flight = 0;
+  std::map<std::string, int> worker_units;
+  std::uint64_t paths = 0;
+  bool started = false;
+  Clock::time_point start_time{}, end_time{};
+  int passes_reported = 0;
+  nlohmann::json history = nlohmann::json::array();
+  std::vector<JobEvent> events;
+  std::string stopped_by;
+  int preview_units = -1;
+  fs::path dir;
+
+  std::size_t unit_index(const WorkUnit& u) const {
+    return (static_cast<std::size_t>(u.pass) * static_cast<std::size_t>(plan.tile_count()) +
+            static_cast<std::size_t>(u.tile)) *
+               static_cast<std::size_t>(plan.batches) +
+           static_cast<std::size_t>(u.batch);
+  }
+  bool active() const { return !is_terminal(record.state); }
+  bool has_work() const {
+    return active() && (!requeued.empty() || cursor < static_cast<std::size_t>(plan.unit_count()));
+  }
+  double elapsed_s() const {
+    if (!started) return 0.0;
+    const auto end = is_terminal(record.state) ? end_time : Clock::now();
+    return std::chrono::duration<double>(end - start_time).count();
+  }
+};
+
+struct InFlight {
+  std::string job_id;
+  WorkUnit unit;
+  std::string worker;
+  Clock::time_point since;
+};
+
+struct WorkerInfo {
+  nlohmann::json info;
+  int units_done = 0;
+  int in_flight = 0;
+  Clock::time_point last_seen;
+};
+
+struct JobService::Impl {
+  fs::path data_dir;
+  ServiceLimits limits;
+  std::unique_ptr<JobStore> store;
+  mutable std::mutex mu;
+  std::condition_variable changed;
+  std::map<std::string, std::unique_ptr<Job>> jobs;
+  std::vector<std::string> order;  // submission order
+  std::map<std::string, std::string> idempotency;
+  std::map<std::uint64_t, InFlight> in_flight;
+  std::uint64_t next_attempt = 1;
+  std::vector<std::pair<std::string, std::uint64_t>> cancelled;
+  std::map<std::string, WorkerInfo> workers;
+  std::int64_t next_sequence = 1;
+  std::uint64_t unit_failures = 0, requeues = 0;
+  std::deque<std::pair<Clock::time_point, std::uint64_t>> recent_paths;  // for samples/s
+
+  Job& add_job(JobRecord record, api::RenderRequest request);
+  void set_state(Job& job, const std::string& state, const std::string& failure = "");
+  void emit(Job& job, const std::string& type);
+  nlohmann::json status_of(const Job& job) const;
+  void finish_if_complete(Job& job);
+  void write_images(Job& job, bool final);
+  void requeue(std::uint64_t attempt, bool tell_worker);
+  void fail_job(Job& job, const std::string& message);
+  void drop_attempts_of(Job& job);
+};
+
+// --- Construction and restart -------------------------------------------------
+
+JobService::JobService(fs::path data_dir, ServiceLimits limits) : impl_(std::make_unique<Impl>()) {
+  impl_->data_dir = std::move(data_dir);
+  impl_->limits = limits;
+  std::error_code ec;
+  fs::create_directories(impl_->data_dir / "jobs", ec);
+  if (ec) throw StorageError("cannot create the data directory " + impl_->data_dir.string() + ": " + ec.message());
+  impl_->store = std::make_unique<JobStore>(impl_->data_dir / "skyfarm.db");
+  // Resume: every job comes back; unfinished ones continue after their merged units.
+  for (JobRecord& r : impl_->store->load_all()) {
+    api::RenderRequest request = api::parse_render_request(r.request);
+    impl_->next_sequence = std::max(impl_->next_sequence, r.sequence + 1);
+    Job& job = impl_->add_job(std::move(r), std::move(request));
+    if (job.record.state == "running") impl_->set_state(job, "queued");
+    if (job.record.state == "done" && !fs::exists(job.dir / "image.exr")) impl_->write_images(job, true);
+    if (job.record.state == "done") job.preview_units = job.merger->merged_units();
+    impl_->finish_if_complete(job);
+  }
+}
+
+JobService::~JobService() = default;
+
+Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
+  auto job = std::make_unique<Job>();
+  job->plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                               request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
+                               request.seed);
+  job->plan_json = plan_report(request, job->plan);
+  job->dir = data_dir / "jobs" / record.id;
+  job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
+  job->passes_reported = job->merger->complete_passes();
+  job->record = std::move(record);
+  job->request = std::move(request);
+  if (!job->record.idempotency_key.empty()) idempotency[job->record.idempotency_key] = job->record.id;
+  order.push_back(job->record.id);
+  Job& ref = *job;
+  jobs[ref.record.id] = std::move(job);
+  return ref;
+}
+
+void JobService::Impl::set_state(Job& job, const std::string& state, const std::string& failure) {
+  store->set_state(job.record.id, state, failure);
+  job.record.state = state;
+  job.record.failure = failure;
+  if (is_terminal(state)) job.end_time = Clock::now();
+}
+
+void JobService::Impl::emit(Job& job, const std::string& type) {
+  JobEvent e;
+  e.sequence = job.events.empty() ? 1 : job.events.back().sequence + 1;
+  e.type = type;
+  e.data = status_of(job);
+  job.events.push_back(std::move(e));
+  if (job.events.size() > 1000) job.events.erase(job.events.begin(), job.events.begin() + 500);
+  changed.notify_all();
+}
+
+// --- HTTP side ------------------------------------------------------------
+
+SubmitResult JobService::submit(const api::RenderRequest& request, const std::optional<std::string>& key) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const std::string canonical = api::canonical_text(request);
+  const std::string hash = request_hash(request);
+  if (key) {
+    const auto it = impl_->idempotency.find(*key);
+    if (it != impl_->idempotency.end()) {
+      const Job& job = *impl_->jobs.at(it->second);
+      if (job.record.request != canonical)
+        throw IdempotencyConflict("Idempotency-Key '" + *key + "' was used for a different request (job " +
+                                  job.record.id + ")");
+      return {job.record.id, false, false};
+    }
+  }
+  // Result cache: an identical request that is done, or still on its way.
+  for (const auto& id : impl_->order) {
+    const Job& job = *impl_->jobs.at(id);
+    if (job.record.request_hash == hash && (job.record.state == "done" || job.active())) {
+      if (key) impl_->idempotency[*key] = job.record.id;
+      return {job.record.id, false, job.record.state == "done"};
+    }
+  }
+  int active = 0;
+  long long queued_units = 0;
+  for (const auto& [id, job] : impl_->jobs) {
+    if (!job->active()) continue;
+    ++active;
+    queued_units += job->plan.unit_count() - job->merger->merged_units();
+  }
+  if (active >= impl_->limits.max_active_jobs)
+    throw CapacityExceeded("too many active jobs (" + std::to_string(active) + "); try again later");
+  const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                                           request.spectral.max_nm, request.spectral.batches,
+                                           request.quality.samples_per_pixel, request.seed);
+  if (queued_units + plan.unit_count() > impl_->limits.max_queue_units)
+    throw CapacityExceeded("the queue is full (" + std::to_string(queued_units) + " units waiting); try again later");
+
+  JobRecord r;
+  r.id = random_id();
+  r.request = canonical;
+  r.request_hash = hash;
+  r.priority = request.priority;
+  r.state = "queued";
+  r.created_unix = unix_now();
+  r.idempotency_key = key.value_or("");
+  r.sequence = impl_->next_sequence++;
+  impl_->store->insert(r);
+  Job& job = impl_->add_job(std::move(r), request);
+  impl_->emit(job, "queued");
+  return {job.record.id, true, false};
+}
+
+nlohmann::json JobService::Impl::status_of(const Job& job) const {
+  const int merged = job.merger->merged_units(), total = job.merger->total_units();
+  const double fraction = total > 0 ? static_cast<double>(merged) / total : 1.0;
+  const double elapsed = job.elapsed_s();
+  const int passes = job.merger->complete_passes();
+  const int spp = std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass);
+  nlohmann::json eta = nullptr;
+  if (job.active() && fraction > 0.0) eta = elapsed * (1.0 - fraction) / fraction;
+  nlohmann::json workers_json = nlohmann::json::array();
+  for (const auto& [id, n] : job.worker_units) workers_json.push_back({{"id", id}, {"units", n}});
+  const std::string self = "/v1/renders/" + job.record.id;
+  nlohmann::json estimate = nullptr;
+  if (!job.history.empty()) estimate = job.history.back()["estimated_relative_rms"];
+  return {{"id", job.record.id},
+          {"state", job.record.state},
+          {"priority", job.record.priority},
+          {"progress",
+           {{"fraction", fraction}, {"samples_per_pixel", spp}, {"units_done", merged}, {"units_total", total}}},
+          {"elapsed_s", elapsed},
+          {"eta_s", eta},
+          {"error", {{"estimated_relative_rms", estimate}, {"history", job.history}}},
+          {"stopped_by", job.stopped_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.stopped_by)},
+          {"plan", job.plan_json},
+          {"workers", workers_json},
+          {"failure", job.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.record.failure)},
+          {"created_unix", job.record.created_unix},
+          {"links",
+           {{"self", self}, {"exr", self + "/image.exr"}, {"png", self + "/image.png"}, {"events", self + "/events"}}}};
+}
+
+std::optional<nlohmann::json> JobService::status(const std::string& id) const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return std::nullopt;
+  return impl_->status_of(*it->second);
+}
+
+nlohmann::json JobService::list(std::size_t offset, std::size_t limit) const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  nlohmann::json out = nlohmann::json::array();
+  const auto& order = impl_->order;
+  for (std::size_t i = offset; i < order.size() && out.size() < limit; ++i)
+    out.push_back(impl_->status_of(*impl_->jobs.at(order[order.size() - 1 - i])));
+  return out;
+}
+
+std::size_t JobService::job_count() const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->jobs.size();
+}
+
+void JobService::Impl::drop_attempts_of(Job& job) {
+  for (auto it = in_flight.begin(); it != in_flight.end();) {
+    if (it->second.job_id == job.record.id) {
+      cancelled.emplace_back(it->second.worker, it->first);
+      if (auto w = workers.find(it->second.worker); w != workers.end()) --w->second.in_flight;
+      it = in_flight.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  job.in_flight = 0;
+  job.requeued.clear();
+}
+
+bool JobService::cancel(const std::string& id) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return false;
+  Job& job = *it->second;
+  if (!job.active()) return true;
+  impl_->drop_attempts_of(job);
+  job.stopped_by = "cancelled";
+  impl_->set_state(job, "cancelled");
+  impl_->emit(job, "cancelled");
+  return true;
+}
+
+// Resolves the merged tiles into an image and writes EXR and PNG next to the
+// job's tiles: image.* when final, preview.* while running (atomic renames,
+// so readers of an older preview keep a complete file).
+void JobService::Impl::write_images(Job& job, bool final) {
+  const auto& out = job.request.output;
+  ImageLayers layers;
+  if (out.spectral_channels)
+    layers.spectral = SpectralLayout{job.plan.lambda_min_nm, job.plan.lambda_max_nm, job.plan.batches};
+  layers.relative_error = out.error_layer;
+  Image image(job.plan.width, job.plan.height, layers);
+  job.merger->resolve(&image);
+  const std::string stem = final ? "image" : "preview";
+  const Sun sun = Sun::from_spec(job.request.sun, job.request.location, job.request.time);
+  api::set_render_metadata(&image, job.request, job.plan, sun,
+                           std::min(job.plan.samples_per_pixel,
+                                    job.merger->complete_passes() * job.plan.samples_per_pass),
+                           job.merger->estimated_relative_rms());
+  try {
+    ExrWriteOptions exr;
+    exr.half = out.half;
+    exr.spectral_channels = out.spectral_channels;
+    exr.error_layer = out.error_layer;
+    exr.latlong_envmap = job.request.camera.projection == Projection::kEquirectangular;
+    write_exr(image, job.dir / (stem + ".exr"), exr);
+    PngWriteOptions png;
+    png.exposure_ev = out.exposure_ev;
+    write_png(image, job.dir / (stem + ".png"), png);
+  } catch (const FileWriteError& e) {
+    throw StorageError(e.what());
+  }
+}
+
+std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat format) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return std::nullopt;
+  Job& job = *it->second;
+  const char* ext = format == ImageFormat::kExr ? ".exr" : ".png";
+  if (job.record.state == "done") {
+    return ImageFile{job.dir / (std::string("image") + ext), "\"" + job.record.request_hash + "\"", true};
+  }
+  if (!job.merger->first_pass_complete()) return std::nullopt;
+  if (job.preview_units != job.merger->merged_units()) {
+    impl_->write_images(job, false);
+    job.preview_units = job.merger->merged_units();
+  }
+  return ImageFile{job.dir / (std::string("preview") + ext),
+                   "\"" + job.record.id + "-" + std::to_string(job.preview_units) + "\"", false};
+}
+
+std::vector<JobEvent> JobService::events_after(const std::string& id, std::uint64_t after,
+                                               std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(impl_->mu);
+  auto ready = [&] {
+    const auto it = impl_->jobs.find(id);
+    return it == impl_->jobs.end() || (!it->second->events.empty() && it->second->events.back().sequence > after);
+  };
+  impl_->changed.wait_for(lock, timeout, ready);
+  std::vector<JobEvent> out;
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return out;
+  for (const auto& e : it->second->events)
+    if (e.sequence > after) out.push_back(e);
+  return out;
+}
+
+nlohmann::json JobService::workers() const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  nlohmann::json out = nlohmann::json::array();
+  const auto now = Clock::now();
+  for (const auto& [id, w] : impl_->workers)
+    out.push_back({{"id", id},
+                   {"cores", w.info.value("cores", 0)},
+                   {"slots", w.info.value("slots", 1)},
+                   {"version", w.info.value("version", "")},
+                   {"units_done", w.units_done},
+                   {"units_in_flight", w.in_flight},
+                   {"last_seen_s", std::chrono::duration<double>(now - w.last_seen).count()}});
+  return out;
+}
+
+nlohmann::json JobService::metrics() const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  long long queue_units = 0;
+  int queued = 0, running = 0, done = 0, failed = 0;
+  for (const auto& [id, job] : impl_->jobs) {
+    const std::string& s = job->record.state;
+    if (job->active()) queue_units += job->plan.unit_count() - job->merger->merged_units() - job->in_flight;
+    queued += s == "queued";
+    running += s == "running";
+    done += s == "done";
+    failed += s == "failed";
+  }
+  // Samples per second: paths merged over the last 10 s.
+  const auto now = Clock::now();
+  std::uint64_t paths = 0;
+  for (const auto& [t, n] : impl_->recent_paths)
+    if (now - t < std::chrono::seconds(10)) paths += n;
+  return {{"queue_units", queue_units},
+          {"units_in_flight", impl_->in_flight.size()},
+          {"jobs_queued", queued},
+          {"jobs_running", running},
+          {"jobs_done", done},
+          {"jobs_failed", failed},
+          {"workers", impl_->workers.size()},
+          {"samples_per_second", static_cast<double>(paths) / 10.0},
+          {"unit_failures", impl_->unit_failures},
+          {"requeues", impl_->requeues}};
+}
+
+// --- Broker side ----------------------------------------------------------
+
+void JobService::worker_joined(const std::string& worker_id, const nlohmann::json& info) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  WorkerInfo& w = impl_->workers[worker_id];
+  w.info = info;
+  w.last_seen = Clock::now();
+}
+
+void JobService::Impl::requeue(std::uint64_t attempt, bool tell_worker) {
+  const auto it = in_flight.find(attempt);
+  if (it == in_flight.end()) return;
+  const InFlight f = it->second;
+  in_flight.erase(it);
+  if (tell_worker) cancelled.emplace_back(f.worker, attempt);
+  if (auto w = workers.find(f.worker); w != workers.end()) --w->second.in_flight;
+  const auto j = jobs.find(f.job_id);
+  if (j == jobs.end()) return;
+  Job& job = *j->second;
+  --job.in_flight;
+  if (job.active() && !job.merger->received(f.unit)) {
+    job.requeued.push_back(f.unit);
+    ++requeues;
+  }
+}
+
+void JobService::worker_left(const std::string& worker_id) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  std::vector<std::uint64_t> attempts;
+  for (const auto& [a, f] : impl_->in_flight)
+    if (f.worker == worker_id) attempts.push_back(a);
+  for (auto a : attempts) impl_->requeue(a, false);
+  impl_->workers.erase(worker_id);
+}
+
+std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  auto& workers = impl_->workers;
+  if (auto w = workers.find(worker_id); w != workers.end()) w->second.last_seen = Clock::now();
+  // Highest priority first, then submission order.
+  Job* best = nullptr;
+  for (const auto& id : impl_->order) {
+    Job& job = *impl_->jobs.at(id);
+    if (!job.has_work()) continue;
+    if (!best || job.record.priority > best->record.priority) best = &job;
+  }
+  if (!best) return std::nullopt;
+  Job& job = *best;
+  std::optional<WorkUnit> unit;
+  while (!job.requeued.empty() && !unit) {
+    const WorkUnit u = job.requeued.front();
+    job.requeued.pop_front();
+    if (!job.merger->received(u)) unit = u;
+  }
+  while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
+    const WorkUnit u = unit_at(job.plan, job.cursor++);
+    if (!job.merger->received(u)) unit = u;
+  }
+  if (!unit) return std::nullopt;
+  if (!job.started) {
+    job.started = true;
+    job.start_time = Clock::now();
+  }
+  if (job.record.state == "queued") {
+    impl_->set_state(job, "running");
+    impl_->emit(job, "progress");
+  }
+  const std::uint64_t attempt = impl_->next_attempt++;
+  impl_->in_flight[attempt] = InFlight{job.record.id, *unit, worker_id, Clock::now()};
+  ++job.in_flight;
+  if (auto w = workers.find(worker_id); w != workers.end()) ++w->second.in_flight;
+  return UnitAssignment{{job.record.id, unit->tile, unit->batch, unit->pass}, attempt, job.record.request};
+}
+
+void JobService::Impl::fail_job(Job& job, const std::string& message) {
+  drop_attempts_of(job);
+  job.stopped_by = "failed";
+  set_state(job, "failed", message);
+  emit(job, "failed");
+}
+
+// When every unit is merged: the final image files, then "done".
+void JobService::Impl::finish_if_complete(Job& job) {
+  const int passes = job.merger->complete_passes();
+  if (passes > job.passes_reported) {
+    job.passes_reported = passes;
+    nlohmann::json e = nullptr;
+    if (const auto rms = job.merger->estimated_relative_rms()) e = *rms;
+    job.history.push_back({{"elapsed_s", job.elapsed_s()},
+                           {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
+                           {"estimated_relative_rms", e}});
+  }
+  if (!job.active() || !job.merger->complete()) return;
+  write_images(job, true);
+  job.preview_units = job.merger->merged_units();
+  job.stopped_by = "samples";
+  set_state(job, "done");
+  emit(job, "done");
+}
+
+void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std::uint64_t attempt,
+                           const std::vector<std::uint8_t>& bytes, std::uint64_t paths) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->in_flight.find(attempt);
+  // A superseded attempt (requeued after a timeout or a lost worker) or a
+  // cancelled job: the result is dropped.
+  if (it == impl_->in_flight.end() || it->second.job_id != key.job_id || it->second.unit.tile != key.tile ||
+      it->second.unit.batch != key.batch || it->second.unit.pass != key.pass)
+    return;
+  const InFlight f = it->second;
+  impl_->in_flight.erase(it);
+  auto& workers = impl_->workers;
+  if (auto w = workers.find(worker_id); w != workers.end()) {
+    --w->second.in_flight;
+    ++w->second.units_done;
+    w->second.last_seen = Clock::now();
+  }
+  Job& job = *impl_->jobs.at(f.job_id);
+  --job.in_flight;
+  if (!job.active()) return;
+  try {
+    FilmTile film = FilmTile::deserialize(bytes);
+    if (job.merger->add(f.unit, std::move(film))) {
+      ++job.worker_units[worker_id];
+      job.paths += paths;
+      impl_->recent_paths.emplace_back(Clock::now(), paths);
+      while (impl_->recent_paths.size() > 10000) impl_->recent_paths.pop_front();
+    }
+  } catch (const FilmTileDecodeError& e) {
+    ++impl_->unit_failures;
+    job.failed_workers[static_cast<int>(job.unit_index(f.unit))].insert(worker_id);
+    job.requeued.push_back(f.unit);
+    return;
+  } catch (const StorageError& e) {
+    impl_->fail_job(job, e.what());
+    return;
+  }
+  try {
+    impl_->finish_if_complete(job);
+  } catch (const StorageError& e) {
+    impl_->fail_job(job, e.what());
+    return;
+  }
+  if (job.active()) impl_->emit(job, "progress");
+}
+
+void JobService::unit_failed(const std::string& worker_id, const UnitKey& key, std::uint64_t attempt,
+                             const std::string& message) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->in_flight.find(attempt);
+  if (it == impl_->in_flight.end() || it->second.job_id != key.job_id) return;
+  const WorkUnit unit = it->second.unit;
+  impl_->requeue(attempt, false);
+  ++impl_->unit_failures;
+  Job& job = *impl_->jobs.at(key.job_id);
+  auto& failed = job.failed_workers[static_cast<int>(job.unit_index(unit))];
+  failed.insert(worker_id);
+  if (static_cast<int>(failed.size()) >= impl_->limits.max_unit_failures && job.active())
+    impl_->fail_job(job, "unit (" + unit_text(unit) + ") failed on " + std::to_string(failed.size()) +
+                             " workers; last error: " + message);
+}
+
+std::vector<std::pair<std::string, std::uint64_t>> JobService::take_cancelled_attempts() {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  std::vector<std::pair<std::string, std::uint64_t>> out;
+  out.swap(impl_->cancelled);
+  return out;
+}
+
+void JobService::check_timeouts(Clock::time_point now) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto limit = std::chrono::duration<double>(impl_->limits.unit_timeout_s);
+  std::vector<std::uint64_t> late;
+  for (const auto& [a, f] : impl_->in_flight)
+    if (now - f.since > limit) late.push_back(a);
+  for (auto a : late) impl_->requeue(a, true);
+}
+
+}  // namespace skyfarm::server

@@ -61,20 +61,6 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
   return "";
 }
 
-void set_metadata(Image* image, const api::RenderRequest& request, const Scene& scene, const RenderPlan& plan,
-                  double estimated_rms) {
-  namespace key = metadata_key;
-  image->set_metadata(key::kRequest, api::canonical_text(request));
-  image->set_metadata(key::kSunZenithDeg, scene.sun().zenith_deg());
-  image->set_metadata(key::kSunAzimuthDeg, scene.sun().azimuth_deg());
-  image->set_metadata(key::kSamplesPerPixel, static_cast<double>(plan.samples_per_pixel));
-  image->set_metadata(key::kWavelengthMinNm, plan.lambda_min_nm);
-  image->set_metadata(key::kWavelengthMaxNm, plan.lambda_max_nm);
-  image->set_metadata(key::kSoftwareVersion, std::string("skyfarm ") + SKYFARM_VERSION);
-  image->set_metadata(key::kEstimatedRelativeRms, estimated_rms);
-  image->set_metadata("method", std::string("path"));
-  image->set_metadata("earth_sun_distance_au", scene.sun().distance_au());
-}
 
 }  // namespace
 
@@ -102,7 +88,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
       render_image(renderer, &image, threads, [&](int done, int total) { progress.update(done, total); });
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  set_metadata(&image, request, scene, plan, result.estimated_relative_rms);
+  api::set_render_metadata(&image, request, plan, scene.sun(), plan.samples_per_pixel, result.estimate);
 
   ExrWriteOptions exr;
   exr.half = request.output.half;

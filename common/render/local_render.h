@@ -6,6 +6,7 @@
 // estimate (DESIGN §6).
 #pragma once
 #include <functional>
+#include <optional>
 
 #include "common/film/image.h"
 #include "common/render/tile_renderer.h"
@@ -18,6 +19,7 @@ using RenderProgress = std::function<void(int done, int total)>;
 struct LocalRenderResult {
   PathCounters counters;
   double estimated_relative_rms = 0.0;  // NaN-free; 0 when nothing has an estimate
+  std::optional<double> estimate;       // the same, nullopt when nothing has an estimate
   int pixels_without_estimate = 0;      // fewer than 2 samples in some batch
 };
 

@@ -1,0 +1,28 @@
+// The image-level estimate of a render's own error (DESIGN §6): per pixel the
+// variance of the luminance mean from the film's sums; per image the
+// luminance-weighted relative RMS error
+//     e = sqrt( sum_i var(Y_i) / sum_i Y_i^2 )
+// over the pixels that have an estimate.  Sums are formed per tile and then
+// added in tile order, so every caller (local render, farm) gets the same bits.
+#pragma once
+#include <optional>
+
+#include "common/film/film_tile.h"
+
+namespace skyfarm {
+
+struct ErrorSums {
+  double sum_var = 0.0;  // sum of var(Y_i) of the mean
+  double sum_Y2 = 0.0;   // sum of Y_i^2
+  int unknown = 0;       // traced pixels with too few samples for an estimate
+  void add(const ErrorSums& o) {
+    sum_var += o.sum_var;
+    sum_Y2 += o.sum_Y2;
+    unknown += o.unknown;
+  }
+  std::optional<double> relative_rms() const;
+};
+
+ErrorSums error_sums(const FilmTile& tile);
+
+}  // namespace skyfarm

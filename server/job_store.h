@@ -1,0 +1,45 @@
+// The persistent record of jobs: an SQLite database in the data directory
+// (jobs and idempotency keys).  Merged film tiles live next to it as files
+// (tile_merger.h).  Every write is a transaction; a failure to write (disk
+// full, read-only directory) throws StorageError naming the database.
+#pragma once
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+struct sqlite3;
+
+namespace skyfarm::server {
+
+struct JobRecord {
+  std::string id;
+  std::string request;      // canonical request text
+  std::string request_hash; // hex hash of `request` (result cache key)
+  int priority = 50;
+  std::string state;        // queued | running | done | failed | cancelled
+  double created_unix = 0.0;
+  std::string failure;      // message when failed
+  std::string idempotency_key;
+  std::int64_t sequence = 0;  // submission order (FIFO within a priority)
+};
+
+class JobStore {
+ public:
+  explicit JobStore(const std::filesystem::path& database);
+  ~JobStore();
+  JobStore(const JobStore&) = delete;
+  JobStore& operator=(const JobStore&) = delete;
+
+  void insert(const JobRecord& job);
+  void set_state(const std::string& id, const std::string& state, const std::string& failure = "");
+  // All jobs in submission order.
+  std::vector<JobRecord> load_all() const;
+
+ private:
+  void exec(const std::string& sql);
+  std::filesystem::path path_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace skyfarm::server

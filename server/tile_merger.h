@@ -1,0 +1,64 @@
+// Merges the results of a job's units into its tiles in canonical order and
+// keeps them on disk.
+//
+// Within a tile, unit (batch b, pass p) has index p * batches + b; results
+// are merged strictly in index order (merge = addition of sums), so the
+// tile's sums are bit-identical to a local render of the tile however many
+// workers ran it and in whatever order the results came back.  A result that
+// arrives early waits in memory until its predecessors are merged.  After
+// each advance the tile (its sums and how many units it holds) is written
+// atomically to <dir>/tile_<t>.bin; a restarted server reloads these files
+// and resumes after the last merged unit of each tile.
+#pragma once
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <vector>
+
+#include "common/film/film_tile.h"
+#include "common/film/image.h"
+#include "common/render/render_plan.h"
+
+namespace skyfarm::server {
+
+class TileMerger {
+ public:
+  // Creates `dir` if needed and reloads the tiles found there.  Throws
+  // StorageError when the directory cannot be created.
+  TileMerger(const RenderPlan& plan, std::filesystem::path dir);
+
+  // A unit's result.  Returns false (and ignores it) when that unit is already
+  // merged or waiting.  Throws FilmTileDecodeError on a tile of the wrong
+  // geometry, StorageError when the tile cannot be written.
+  bool add(const WorkUnit& unit, FilmTile film);
+  // Merged into its tile (and so on disk).
+  bool merged(const WorkUnit& unit) const;
+  // Merged or waiting in memory.
+  bool received(const WorkUnit& unit) const;
+
+  int merged_units() const { return merged_units_; }
+  int total_units() const { return plan_.unit_count(); }
+  bool complete() const { return merged_units_ == total_units(); }
+  // Passes merged in every tile (all batches).
+  int complete_passes() const;
+  bool first_pass_complete() const { return complete_passes() >= 1; }
+
+  // Resolves every tile into `image` (sizes must match).
+  void resolve(Image* image) const;
+  // sqrt(sum_i var(Y_i) / sum_i Y_i^2) over pixels with an estimate, or nullopt.
+  std::optional<double> estimated_relative_rms() const;
+
+ private:
+  int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }
+  void persist(int tile) const;
+  void load();
+
+  RenderPlan plan_;
+  std::filesystem::path dir_;
+  std::vector<FilmTile> tiles_;
+  std::vector<int> next_index_;                   // per tile: units merged
+  std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
+  int merged_units_ = 0;
+};
+
+}  // namespace skyfarm::server

@@ -1,0 +1,263 @@
+// The farm's job service without the network: units handed out, rendered by
+// a simulated worker, merged in canonical order whatever the arrival order;
+// the final EXR equals `skyfarm-worker render` byte for byte; idempotency,
+// the result cache, stale attempts, failures, cancellation and restarts.
+#include "server/job_service.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <random>
+#include <unistd.h>
+
+#include "api/render_setup.h"
+#include "common/render/tile_renderer.h"
+
+namespace skyfarm::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kRequest = R"({
+  "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+  "camera": {"projection": "equirectangular", "width": 40, "height": 20},
+  "spectral": {"batches": 2},
+  "quality": {"samples_per_pixel": 48},
+  "output": {"half": false, "error_layer": true},
+  "seed": 3
+})";
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("skyfarm_js_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  return d;
+}
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A simulated worker: renders an assignment exactly as a farm worker does.
+std::vector<std::uint8_t> render_assignment(const UnitAssignment& a) {
+  const api::RenderRequest request = api::parse_render_request(a.request_canonical);
+  const api::RenderSetup setup = api::make_render_setup(request);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  FilmTile film = renderer.empty_tile(a.key.tile);
+  PathCounters counters;
+  renderer.render_unit({a.key.tile, a.key.batch, a.key.pass}, &film, &counters);
+  return film.serialize();
+}
+
+// Hands out up to `batch` units, then returns their results in a shuffled order.
+void run_shuffled(JobService& service, std::mt19937& rng, std::size_t batch, int max_rounds = 100000) {
+  for (int round = 0; round < max_rounds; ++round) {
+    std::vector<UnitAssignment> got;
+    while (got.size() < batch) {
+      auto a = service.next_unit("w" + std::to_string(got.size() % 3));
+      if (!a) break;
+      got.push_back(*a);
+    }
+    if (got.empty()) return;
+    std::shuffle(got.begin(), got.end(), rng);
+    for (const auto& a : got)
+      service.unit_done("w" + std::to_string(a.attempt % 3), a.key, a.attempt, render_assignment(a), 1);
+  }
+}
+
+std::string local_render_exr(const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "request.json") << kRequest;
+  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "request.json").string() +
+                          " -o " + (dir / "local.exr").string() + " > /dev/null 2>&1";
+  EXPECT_EQ(std::system(cmd.c_str()), 0);
+  return read_file(dir / "local.exr");
+}
+
+TEST(JobService, ShuffledUnitsGiveTheSameExrBytesAsALocalRender) {
+  const fs::path dir = fresh_dir("bytes");
+  JobService service(dir);
+  const auto submitted = service.submit(api::parse_render_request(kRequest), std::nullopt);
+  EXPECT_TRUE(submitted.created);
+  EXPECT_FALSE(service.image(submitted.id, ImageFormat::kExr).has_value()) << "no image before the first pass";
+  std::mt19937 rng(4);
+  // Workers (simulated) "w0".."w2" join.
+  for (int w = 0; w < 3; ++w) service.worker_joined("w" + std::to_string(w), {{"cores", 2}, {"slots", 2}});
+  run_shuffled(service, rng, 7);
+  const auto status = service.status(submitted.id);
+  ASSERT_TRUE(status);
+  EXPECT_EQ((*status)["state"], "done");
+  EXPECT_EQ((*status)["stopped_by"], "samples");
+  EXPECT_EQ((*status)["progress"]["units_done"], (*status)["progress"]["units_total"]);
+  EXPECT_EQ((*status)["progress"]["samples_per_pixel"], 48);
+  EXPECT_EQ((*status)["plan"]["passes"], 3);
+  EXPECT_FALSE((*status)["error"]["history"].empty());
+  EXPECT_EQ((*status)["plan"]["batches"], 2);
+  const auto image = service.image(submitted.id, ImageFormat::kExr);
+  ASSERT_TRUE(image);
+  EXPECT_TRUE(image->final);
+  EXPECT_EQ(read_file(image->path), local_render_exr(dir / "local")) << "farm EXR must equal the local render's";
+}
+
+TEST(JobService, IdempotencyKeyAndResultCache) {
+  JobService service(fresh_dir("idem"));
+  const auto request = api::parse_render_request(kRequest);
+  const auto a = service.submit(request, std::string("key-1"));
+  const auto b = service.submit(request, std::string("key-1"));
+  EXPECT_EQ(a.id, b.id);
+  EXPECT_FALSE(b.created);
+  auto other = request;
+  other.seed = 4;
+  EXPECT_THROW(service.submit(other, std::string("key-1")), IdempotencyConflict);
+  // The same request without a key while the first is queued: the same job.
+  EXPECT_EQ(service.submit(request, std::nullopt).id, a.id);
+  // A different priority renders the same image: still the same job.
+  auto urgent = request;
+  urgent.priority = 90;
+  EXPECT_EQ(service.submit(urgent, std::nullopt).id, a.id);
+  std::mt19937 rng(1);
+  run_shuffled(service, rng, 4);
+  const auto cached = service.submit(request, std::nullopt);
+  EXPECT_EQ(cached.id, a.id);
+  EXPECT_TRUE(cached.from_cache);
+  EXPECT_EQ(service.job_count(), 1u);
+}
+
+TEST(JobService, StaleAttemptsAreDroppedAndTimeoutsRequeue) {
+  ServiceLimits limits;
+  limits.unit_timeout_s = 1.0;
+  JobService service(fresh_dir("stale"), limits);
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  const auto first = service.next_unit("slow");
+  ASSERT_TRUE(first);
+  service.check_timeouts(Clock::now() + std::chrono::seconds(5));
+  const auto cancelled = service.take_cancelled_attempts();
+  ASSERT_EQ(cancelled.size(), 1u);
+  EXPECT_EQ(cancelled[0], (std::pair<std::string, std::uint64_t>("slow", first->attempt)));
+  // The slow worker's late result is ignored; the unit comes back with a new attempt.
+  service.unit_done("slow", first->key, first->attempt, render_assignment(*first), 1);
+  EXPECT_EQ((*service.status(id))["progress"]["units_done"], 0);
+  const auto again = service.next_unit("fast");
+  ASSERT_TRUE(again);
+  EXPECT_EQ(again->key, first->key);
+  EXPECT_NE(again->attempt, first->attempt);
+  service.unit_done("fast", again->key, again->attempt, render_assignment(*again), 1);
+  EXPECT_EQ((*service.status(id))["progress"]["units_done"], 1);
+}
+
+TEST(JobService, LostWorkerUnitsAreRequeued) {
+  JobService service(fresh_dir("lost"));
+  service.submit(api::parse_render_request(kRequest), std::nullopt);
+  service.worker_joined("doomed", {{"cores", 1}});
+  const auto a = service.next_unit("doomed");
+  ASSERT_TRUE(a);
+  service.worker_left("doomed");
+  const auto b = service.next_unit("other");
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->key, a->key);
+  EXPECT_EQ(service.workers().size(), 0u);
+}
+
+TEST(JobService, UnitFailingOnThreeWorkersFailsTheJobWithTheMessage) {
+  JobService service(fresh_dir("fail"));
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  for (int w = 0; w < 3; ++w) {
+    const auto a = service.next_unit("w" + std::to_string(w));
+    ASSERT_TRUE(a);
+    service.unit_failed("w" + std::to_string(w), a->key, a->attempt, "out of memory on w" + std::to_string(w));
+  }
+  const auto s = *service.status(id);
+  EXPECT_EQ(s["state"], "failed");
+  EXPECT_EQ(s["stopped_by"], "failed");
+  EXPECT_NE(s["failure"].get<std::string>().find("out of memory on w2"), std::string::npos);
+  EXPECT_FALSE(service.next_unit("w9").has_value());
+}
+
+TEST(JobService, CancelStopsDispatchAndListsAttempts) {
+  JobService service(fresh_dir("cancel"));
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  const auto a = service.next_unit("w");
+  ASSERT_TRUE(a);
+  EXPECT_TRUE(service.cancel(id));
+  EXPECT_EQ((*service.status(id))["state"], "cancelled");
+  EXPECT_EQ(service.take_cancelled_attempts().size(), 1u);
+  EXPECT_FALSE(service.next_unit("w").has_value());
+  EXPECT_FALSE(service.cancel("no-such-job"));
+  const auto events = service.events_after(id, 0, std::chrono::milliseconds(0));
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.back().type, "cancelled");
+}
+
+TEST(JobService, RestartResumesFromMergedPassesWithIdenticalBytes) {
+  const fs::path dir = fresh_dir("restart");
+  std::string id;
+  std::mt19937 rng(9);
+  {
+    JobService service(dir);
+    id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+    // Half the units, some left in flight when the server "dies".
+    for (int i = 0; i < 9; ++i) {
+      const auto a = service.next_unit("w");
+      ASSERT_TRUE(a);
+      if (i % 3 != 2) service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+    }
+    EXPECT_GT((*service.status(id))["progress"]["units_done"].get<int>(), 0);
+  }
+  JobService restarted(dir);
+  const auto s = *restarted.status(id);
+  EXPECT_EQ(s["state"], "queued");
+  EXPECT_GT(s["progress"]["units_done"].get<int>(), 0) << "merged passes survive the restart";
+  run_shuffled(restarted, rng, 5);
+  EXPECT_EQ((*restarted.status(id))["state"], "done");
+  EXPECT_EQ(read_file(*&restarted.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local"));
+  // And a done job stays downloadable after another restart.
+  JobService again(dir);
+  EXPECT_EQ((*again.status(id))["state"], "done");
+  EXPECT_TRUE(fs::exists(again.image(id, ImageFormat::kPng)->path));
+}
+
+TEST(JobService, PreviewAfterFirstPassWithChangingEtag) {
+  JobService service(fresh_dir("preview"));
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  const auto s = *service.status(id);
+  const int first_pass_units = s["plan"]["tiles"].get<int>() * s["plan"]["batches"].get<int>();
+  for (int i = 0; i < first_pass_units; ++i) {
+    const auto a = service.next_unit("w");
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->key.pass, 0) << "pass 0 of every tile comes first";
+    service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+  }
+  const auto preview = service.image(id, ImageFormat::kPng);
+  ASSERT_TRUE(preview);
+  EXPECT_FALSE(preview->final);
+  const auto a = service.next_unit("w");
+  ASSERT_TRUE(a);
+  service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+  EXPECT_NE(service.image(id, ImageFormat::kPng)->etag, preview->etag);
+}
+
+TEST(JobService, UnwritableDataDirectoryIsAStorageError) {
+  EXPECT_THROW(JobService("/proc/skyfarm-cannot-write-here"), StorageError);
+}
+
+TEST(JobService, HigherPriorityJobsGoFirst) {
+  JobService service(fresh_dir("priority"));
+  auto low = api::parse_render_request(kRequest);
+  low.priority = 10;
+  auto high = low;
+  high.priority = 90;
+  high.seed = 77;
+  const auto low_id = service.submit(low, std::nullopt).id;
+  const auto high_id = service.submit(high, std::nullopt).id;
+  const auto a = service.next_unit("w");
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->key.job_id, high_id);
+  EXPECT_NE(low_id, high_id);
+}
+
+}  // namespace
+}  // namespace skyfarm::server
