@@ -177,6 +177,9 @@ JobService::JobService(fs::path data_dir, ServiceLimits limits) : impl_(std::mak
   fs::create_directories(impl_->data_dir / "jobs", ec);
   if (ec) throw StorageError("cannot create the data directory " + impl_->data_dir.string() + ": " + ec.message());
   impl_->store = std::make_unique<JobStore>(impl_->data_dir / "skyfarm.db");
+  // Attempt ids stay unique across restarts (a late result from before a
+  // restart can never match a new dispatch): start from the clock.
+  impl_->next_attempt = static_cast<std::uint64_t>(unix_now() * 1000.0) << 16;
   // Resume: every job comes back; unfinished ones continue after their merged units.
   for (JobRecord& r : impl_->store->load_all()) {
     api::RenderRequest request = api::parse_render_request(r.request);
@@ -428,14 +431,18 @@ nlohmann::json JobService::workers() const {
   const std::lock_guard<std::mutex> lock(impl_->mu);
   nlohmann::json out = nlohmann::json::array();
   const auto now = Clock::now();
-  for (const auto& [id, w] : impl_->workers)
+  for (const auto& [id, w] : impl_->workers) {
+    auto field = [&info = w.info](const char* name) {
+      return info.contains(name) ? info[name] : nlohmann::json(nullptr);
+    };
     out.push_back({{"id", id},
-                   {"cores", w.info.value("cores", 0)},
-                   {"slots", w.info.value("slots", 1)},
-                   {"version", w.info.value("version", "")},
+                   {"cores", field("cores")},
+                   {"slots", field("slots")},
+                   {"version", field("version")},
                    {"units_done", w.units_done},
                    {"units_in_flight", w.in_flight},
                    {"last_seen_s", std::chrono::duration<double>(now - w.last_seen).count()}});
+  }
   return out;
 }
 

@@ -1,11 +1,13 @@
 // skyfarm-worker: the worker side of skyfarm.
+//   skyfarm-worker [--connect tcp://HOST:PORT] [--threads N] [--slots N] [--token SECRET]
+//                  the farm worker (the default mode: no command, or a first argument
+//                  starting with "--"); each flag also reads SKYFARM_<FLAG>
 //   skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]
 //   skyfarm-worker probe PROBE.json|- [--threads N]
 //   skyfarm-worker demo [DIR]
 //   skyfarm-worker bench [paths|demo|memory|all] [--repeat N]
 //   skyfarm-worker info REQUEST.json [--json]   the request's sun and optical depths
 //   skyfarm-worker --help | --version
-// The farm worker loop (`--connect`) arrives with the server (issue 4).
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -17,13 +19,18 @@
 #include "api/render_request.h"
 #include "worker/bench_command.h"
 #include "worker/cli_io.h"
+#include "worker/farm_worker.h"
 #include "worker/render_command.h"
 #include "worker/sky_report.h"
 
 namespace {
 
 constexpr const char* kUsage =
-    "usage: skyfarm-worker <command> [options]\n"
+    "usage: skyfarm-worker [farm options]\n"
+    "       skyfarm-worker <command> [options]\n"
+    "\n"
+    "farm worker (no command):\n"
+    "%FARM%"
     "\n"
     "commands:\n"
     "  render REQUEST.json -o OUT.exr [--png OUT.png [--png-16bit]] [--threads N]\n"
@@ -41,6 +48,12 @@ constexpr const char* kUsage =
     "  --help      this text\n"
     "  --version   the skyfarm version\n";
 
+std::string usage() {
+  std::string text = kUsage;
+  text.replace(text.find("%FARM%"), 6, skyfarm::kFarmWorkerUsage);
+  return text;
+}
+
 int run_info(const std::vector<std::string>& args) {
   std::string path;
   bool json = false;
@@ -50,12 +63,12 @@ int run_info(const std::vector<std::string>& args) {
     } else if (path.empty()) {
       path = a;
     } else {
-      std::cerr << "skyfarm-worker info: unexpected argument '" << a << "'\n" << kUsage;
+      std::cerr << "skyfarm-worker info: unexpected argument '" << a << "'\n" << usage();
       return 2;
     }
   }
   if (path.empty()) {
-    std::cerr << "skyfarm-worker info: a request file is required\n" << kUsage;
+    std::cerr << "skyfarm-worker info: a request file is required\n" << usage();
     return 2;
   }
   std::string text, error;
@@ -81,14 +94,15 @@ int run_info(const std::vector<std::string>& args) {
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    std::cout << kUsage;
-    return args.empty() ? 2 : 0;
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h" || args[0] == "help")) {
+    std::cout << usage();
+    return 0;
   }
-  if (args[0] == "--version") {
+  if (!args.empty() && args[0] == "--version") {
     std::cout << "skyfarm " << SKYFARM_VERSION << "\n";
     return 0;
   }
+  if (args.empty() || args[0].rfind("--", 0) == 0) return skyfarm::run_farm_worker_command(args);
   const std::string command = args[0];
   args.erase(args.begin());
   if (command == "info") return run_info(args);
@@ -96,6 +110,6 @@ int main(int argc, char** argv) {
   if (command == "probe") return skyfarm::run_probe_command(args);
   if (command == "bench") return skyfarm::run_bench_command(args);
   if (command == "demo") return skyfarm::run_demo_command(args);
-  std::cerr << "skyfarm-worker: unknown command '" << command << "'\n" << kUsage;
+  std::cerr << "skyfarm-worker: unknown command '" << command << "'\n" << usage();
   return 2;
 }

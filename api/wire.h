@@ -1,0 +1,170 @@
+// The server <-> worker protocol of the render farm (DESIGN §4), as ZeroMQ
+// multipart frames.  The server binds a ROUTER, every worker connects a
+// DEALER.  A DEALER sends and receives
+//
+//     [command] [header JSON object] [payload]        (payload: RESULT only)
+//
+// and the ROUTER sees the peer's routing identity as an extra first frame
+// (server/broker.cpp strips and adds it; this file never sees it).  The
+// command frame is the ASCII name below; the header is a JSON object (an
+// empty header frame, or none at all, reads as {} for commands without
+// required fields); results travel as binary FilmTile::serialize() bytes,
+// never as JSON floats.
+//
+//   command     direction        header fields                                  payload
+//   READY       worker -> server id, cores, slots, version, capabilities,      -
+//                                heartbeat_ms?, token?
+//   HEARTBEAT   both ways        heartbeat_ms? (sender's interval),            -
+//                                draining? (worker: send no more units)
+//   UNIT        server -> worker job, tile, batch, pass, attempt, request      -
+//                                (request: api::canonical_text of the job)
+//   RESULT      worker -> server job, tile, batch, pass, attempt, paths,        FilmTile bytes
+//                                seconds
+//   FAILED      worker -> server job, tile, batch, pass, attempt, message       -
+//   CANCEL      server -> worker attempt                                        -
+//   DISCONNECT  both ways        reason?, fatal? (server: do not reconnect)     -
+//   REREGISTER  server -> worker -  (the server does not know this peer: READY) -
+//
+// Versioning: READY carries kProtocolVersion; the server refuses another
+// version with a fatal DISCONNECT.  Decoding is strict: an unknown command, a
+// header that is not a JSON object, a missing or mistyped field, a value out
+// of range or a wrong frame count throws WireError (the receivers count such
+// messages and drop them; nothing here trusts the peer).  Unknown extra
+// header fields are ignored, so later versions may add fields.
+#pragma once
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace skyfarm::api {
+
+inline constexpr int kProtocolVersion = 1;
+
+// Bounds on what a peer may send (a header is small JSON; the request text of
+// a unit may carry tables such as sun.irradiance).
+inline constexpr std::size_t kMaxHeaderBytes = 16u << 20;
+inline constexpr std::size_t kMaxIdBytes = 256;
+inline constexpr std::size_t kMaxMessageBytes = 64u << 10;  // FAILED text (longer ones are cut on encode)
+inline constexpr int kMaxSlots = 1024;
+
+// One ZeroMQ message: its frames as byte strings (identity frame excluded).
+using Frames = std::vector<std::string>;
+
+class WireError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Command { kReady, kHeartbeat, kUnit, kResult, kFailed, kCancel, kDisconnect, kReregister };
+
+std::string_view command_name(Command command);
+std::optional<Command> command_from_name(std::string_view name);
+
+// --- Messages -----------------------------------------------------------------
+
+struct ReadyMsg {
+  std::string id;                 // worker id, unique per worker process
+  int cores = 1;                  // hardware threads it renders with
+  int slots = 1;                  // units it may hold at once (its credit)
+  int version = kProtocolVersion;
+  nlohmann::json capabilities = nlohmann::json::object();  // e.g. {"spectral": true}
+  int heartbeat_ms = 0;           // the worker's heartbeat interval (0: not told)
+  std::optional<std::string> token;
+  bool operator==(const ReadyMsg&) const = default;
+};
+
+struct HeartbeatMsg {
+  int heartbeat_ms = 0;   // the sender's heartbeat interval (0: not told)
+  bool draining = false;  // worker: finishing its units, send no more
+  bool operator==(const HeartbeatMsg&) const = default;
+};
+
+// The unit fields shared by UNIT, RESULT and FAILED.
+struct UnitRef {
+  std::string job;
+  int tile = 0, batch = 0, pass = 0;
+  std::uint64_t attempt = 0;
+  bool operator==(const UnitRef&) const = default;
+};
+
+struct UnitMsg {
+  UnitRef unit;
+  std::string request;  // canonical request text
+  bool operator==(const UnitMsg&) const = default;
+};
+
+struct ResultMsg {
+  UnitRef unit;
+  std::uint64_t paths = 0;
+  double seconds = 0.0;
+  std::string film_tile;  // FilmTile::serialize() bytes, not checked here
+  bool operator==(const ResultMsg&) const = default;
+};
+
+struct FailedMsg {
+  UnitRef unit;
+  std::string message;
+  bool operator==(const FailedMsg&) const = default;
+};
+
+struct CancelMsg {
+  std::uint64_t attempt = 0;
+  bool operator==(const CancelMsg&) const = default;
+};
+
+struct DisconnectMsg {
+  std::string reason;
+  bool fatal = false;  // server -> worker: a refusal (bad token, version); do not retry
+  bool operator==(const DisconnectMsg&) const = default;
+};
+
+struct ReregisterMsg {
+  bool operator==(const ReregisterMsg&) const = default;
+};
+
+using Message =
+    std::variant<ReadyMsg, HeartbeatMsg, UnitMsg, ResultMsg, FailedMsg, CancelMsg, DisconnectMsg, ReregisterMsg>;
+
+Command command_of(const Message& message);
+
+// --- Encoding and decoding --------------------------------------------------
+
+Frames encode(const Message& message);
+// Throws WireError (with what was wrong) for anything encode could not have produced.
+Message decode(const Frames& frames);
+// decode that returns nullopt instead of throwing; *error (if given) gets the reason.
+std::optional<Message> try_decode(const Frames& frames, std::string* error = nullptr);
+
+// The byte payload of a RESULT as the backend takes it.
+inline std::vector<std::uint8_t> payload_bytes(const std::string& payload) {
+  return {payload.begin(), payload.end()};
+}
+
+// --- Wake-up pipe -------------------------------------------------------------
+// A non-blocking self-pipe the broker and worker I/O threads add to their
+// zmq_poll set (as a file descriptor), so other threads can wake them
+// without touching their sockets: notify() is thread-safe and
+// async-signal-safe; drain() (owner thread) empties it.
+class WakeupPipe {
+ public:
+  WakeupPipe();
+  ~WakeupPipe();
+  WakeupPipe(const WakeupPipe&) = delete;
+  WakeupPipe& operator=(const WakeupPipe&) = delete;
+
+  int read_fd() const { return fds_[0]; }
+  void notify() const noexcept;
+  void drain() const noexcept;
+
+ private:
+  int fds_[2] = {-1, -1};
+};
+
+}  // namespace skyfarm::api

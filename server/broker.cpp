@@ -1,0 +1,455 @@
+#include "server/broker.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <iostream>
+#include <map>
+#include <unordered_map>
+#include <vector>
+
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "api/wire.h"
+
+namespace skyfarm::server {
+namespace {
+
+using Ms = std::chrono::milliseconds;
+
+// Constant-time comparison of a shared secret.
+bool same_secret(const std::string& expected, const std::string& given) {
+  unsigned diff = expected.size() == given.size() ? 0u : 1u;
+  for (std::size_t i = 0; i < given.size(); ++i)
+    diff |= static_cast<unsigned>(static_cast<unsigned char>(given[i]) ^
+                                  static_cast<unsigned char>(expected.empty() ? 0 : expected[i % expected.size()]));
+  return diff == 0;
+}
+
+std::string printable(const std::string& bytes) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  for (const unsigned char c : bytes.substr(0, 16)) {
+    out += kHex[c >> 4];
+    out += kHex[c & 15];
+  }
+  return out;
+}
+
+UnitKey key_of(const api::UnitRef& u) { return UnitKey{u.job, u.tile, u.batch, u.pass}; }
+
+}  // namespace
+
+struct Broker::Shared {
+  std::atomic<bool> stop{false};
+  api::WakeupPipe wakeup;
+  std::atomic<std::uint64_t> workers{0}, joined{0}, left{0}, lost{0}, rejected{0}, units_sent{0}, results{0},
+      failures{0}, cancels_sent{0}, malformed{0}, unexpected{0}, reregisters_sent{0}, backend_errors{0};
+};
+
+// Everything the broker thread owns.  Built (and bound) in start() on the
+// caller's thread, then used only by the broker thread (the thread start is
+// the memory fence ZeroMQ asks for when a socket changes threads).
+struct Broker::Loop {
+  struct Worker {
+    std::string identity;  // ROUTER routing id
+    std::string id;        // READY "id"
+    int slots = 1;
+    bool draining = false;
+    std::map<std::uint64_t, UnitKey> in_flight;  // attempt -> unit
+    Clock::duration expiry_span{};
+    Clock::time_point expiry{};
+    bool has_credit() const { return !draining && static_cast<int>(in_flight.size()) < slots; }
+  };
+
+  Loop(BrokerBackend& backend, const BrokerOptions& options, Shared& shared)
+      : backend_(backend), options_(options), shared_(shared), router_(ctx_, zmq::socket_type::router) {
+    router_.set(zmq::sockopt::linger, 0);
+    router_.set(zmq::sockopt::router_mandatory, 1);
+    router_.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(options_.max_message_bytes));
+    router_.set(zmq::sockopt::sndtimeo, 0);
+    router_.bind(options_.endpoint);
+    bound_ = router_.get(zmq::sockopt::last_endpoint);
+  }
+
+  const std::string& bound() const { return bound_; }
+  void run();
+
+ private:
+  // --- sending
+  bool send(const std::string& identity, const api::Message& message);
+  void send_or_lose(const std::string& identity, const api::Message& message);
+  // --- receiving
+  void receive_all();
+  void handle(std::vector<zmq::message_t>& parts);
+  void handle_ready(const std::string& identity, const api::ReadyMsg& ready);
+  void handle_known(Worker& w, const api::Message& message);
+  void handle_result(Worker& w, const api::ResultMsg& r);
+  void handle_failed(Worker& w, const api::FailedMsg& f);
+  // --- workers
+  void refuse(const std::string& identity, const std::string& reason);
+  void register_worker(const std::string& identity, const api::ReadyMsg& ready);
+  void remove_worker(const std::string& identity, const char* why, bool lost);
+  Clock::duration expiry_span(int worker_heartbeat_ms) const;
+  // --- periodic work
+  void housekeeping(Clock::time_point now);
+  void heartbeat_all();
+  void expire(Clock::time_point now);
+  void send_cancels();
+  void dispatch();
+  void shutdown();
+  Ms poll_timeout(Clock::time_point now) const;
+  template <class F>
+  void guarded(const char* what, F&& f);
+  void log(const std::string& line) const;
+
+  BrokerBackend& backend_;
+  const BrokerOptions& options_;
+  Shared& shared_;
+  zmq::context_t ctx_{1};
+  zmq::socket_t router_;
+  std::string bound_;
+  std::map<std::string, Worker> workers_;                  // by identity
+  std::unordered_map<std::string, std::string> identity_of_;  // worker id -> identity
+  std::size_t round_robin_ = 0;
+  Clock::time_point next_heartbeat_{}, next_timeout_check_{};
+};
+
+// --- Loop: main -----------------------------------------------------------------
+
+void Broker::Loop::run() {
+  const Clock::time_point start = Clock::now();
+  next_heartbeat_ = start + options_.heartbeat_interval;
+  next_timeout_check_ = start;
+  while (!shared_.stop.load()) {
+    zmq::pollitem_t items[] = {{router_.handle(), 0, ZMQ_POLLIN, 0},
+                               {nullptr, shared_.wakeup.read_fd(), ZMQ_POLLIN, 0}};
+    try {
+      zmq::poll(items, 2, poll_timeout(Clock::now()));
+      if (items[1].revents & ZMQ_POLLIN) shared_.wakeup.drain();
+      if (items[0].revents & ZMQ_POLLIN) receive_all();
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR) {
+        log(std::string("broker: ZeroMQ error, stopping: ") + e.what());
+        break;
+      }
+    }
+    if (shared_.stop.load()) break;
+    housekeeping(Clock::now());
+  }
+  shutdown();
+}
+
+Ms Broker::Loop::poll_timeout(Clock::time_point now) const {
+  const Ms tick = std::min(options_.poll_interval, options_.heartbeat_interval);
+  const auto to_heartbeat = std::chrono::duration_cast<Ms>(next_heartbeat_ - now);
+  return std::clamp(to_heartbeat, Ms(0), std::max(tick, Ms(1)));
+}
+
+void Broker::Loop::housekeeping(Clock::time_point now) {
+  expire(now);
+  if (now >= next_heartbeat_) {
+    heartbeat_all();
+    next_heartbeat_ = now + options_.heartbeat_interval;
+  }
+  send_cancels();
+  if (now >= next_timeout_check_) {
+    guarded("check_timeouts", [&] { backend_.check_timeouts(now); });
+    next_timeout_check_ = now + options_.timeout_check_interval;
+  }
+  dispatch();
+}
+
+void Broker::Loop::shutdown() {
+  const api::Message bye = api::DisconnectMsg{"server shutting down", false};
+  std::vector<std::string> identities;
+  for (const auto& [identity, w] : workers_) identities.push_back(identity);
+  for (const auto& identity : identities) {
+    send(identity, bye);
+    remove_worker(identity, "server shutting down", false);
+  }
+  try {
+    router_.set(zmq::sockopt::linger, static_cast<int>(options_.shutdown_linger.count()));
+  } catch (const zmq::error_t&) {
+  }
+  router_.close();
+}
+
+// --- Loop: sending ----------------------------------------------------------------
+
+// Never blocks: false when the peer is gone (EHOSTUNREACH under
+// ROUTER_MANDATORY) or its queue is full (EAGAIN).  Only the identity frame
+// can fail; the rest of a message follows it atomically.
+bool Broker::Loop::send(const std::string& identity, const api::Message& message) {
+  const api::Frames frames = api::encode(message);
+  try {
+    if (!router_.send(zmq::buffer(identity), zmq::send_flags::sndmore | zmq::send_flags::dontwait)) return false;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const auto more = i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+      (void)router_.send(zmq::buffer(frames[i]), more | zmq::send_flags::dontwait);
+    }
+    return true;
+  } catch (const zmq::error_t& e) {
+    if (e.num() != EHOSTUNREACH) log(std::string("broker: send failed: ") + e.what());
+    return false;
+  }
+}
+
+void Broker::Loop::send_or_lose(const std::string& identity, const api::Message& message) {
+  if (!send(identity, message) && workers_.count(identity)) remove_worker(identity, "unreachable", true);
+}
+
+// --- Loop: receiving --------------------------------------------------------------
+
+void Broker::Loop::receive_all() {
+  // Bounded, so a flood cannot starve heartbeats and expiry.
+  for (int i = 0; i < 1000 && !shared_.stop.load(); ++i) {
+    std::vector<zmq::message_t> parts;
+    if (!zmq::recv_multipart(router_, std::back_inserter(parts), zmq::recv_flags::dontwait)) return;
+    handle(parts);
+  }
+}
+
+void Broker::Loop::handle(std::vector<zmq::message_t>& parts) {
+  if (parts.empty()) return;
+  const std::string identity = parts[0].to_string();
+  api::Frames frames;
+  frames.reserve(parts.size() - 1);
+  for (std::size_t i = 1; i < parts.size(); ++i) frames.push_back(parts[i].to_string());
+  const auto known = workers_.find(identity);
+  if (known != workers_.end()) known->second.expiry = Clock::now() + known->second.expiry_span;
+
+  std::string error;
+  const std::optional<api::Message> message = api::try_decode(frames, &error);
+  if (!message) {
+    const auto n = ++shared_.malformed;
+    if (n <= 10 || (n & (n - 1)) == 0)
+      log("broker: dropped a malformed message from peer " + printable(identity) + ": " + error + " (" +
+          std::to_string(n) + " so far)");
+    return;
+  }
+  if (const auto* ready = std::get_if<api::ReadyMsg>(&*message)) {
+    handle_ready(identity, *ready);
+  } else if (known != workers_.end()) {
+    handle_known(known->second, *message);
+  } else if (!std::holds_alternative<api::DisconnectMsg>(*message)) {
+    // A peer we do not know (we restarted, or declared it lost): ask it to READY again.
+    if (send(identity, api::ReregisterMsg{})) ++shared_.reregisters_sent;
+  }
+}
+
+void Broker::Loop::handle_ready(const std::string& identity, const api::ReadyMsg& ready) {
+  if (ready.version != api::kProtocolVersion) {
+    refuse(identity, "protocol version " + std::to_string(ready.version) + " not supported (server speaks " +
+                         std::to_string(api::kProtocolVersion) + ")");
+    return;
+  }
+  if (!options_.token.empty() && !(ready.token && same_secret(options_.token, *ready.token))) {
+    refuse(identity, "unauthorized: wrong or missing token");
+    return;
+  }
+  if (workers_.count(identity)) remove_worker(identity, "sent READY again", false);
+  if (const auto it = identity_of_.find(ready.id); it != identity_of_.end())
+    remove_worker(it->second, "reconnected", false);
+  register_worker(identity, ready);
+}
+
+void Broker::Loop::handle_known(Worker& w, const api::Message& message) {
+  if (const auto* hb = std::get_if<api::HeartbeatMsg>(&message)) {
+    if (hb->draining && !w.draining) log("broker: worker " + w.id + " is draining");
+    w.draining = w.draining || hb->draining;
+    if (hb->heartbeat_ms > 0) w.expiry_span = expiry_span(hb->heartbeat_ms);
+  } else if (const auto* r = std::get_if<api::ResultMsg>(&message)) {
+    handle_result(w, *r);
+  } else if (const auto* f = std::get_if<api::FailedMsg>(&message)) {
+    handle_failed(w, *f);
+  } else if (std::holds_alternative<api::DisconnectMsg>(message)) {
+    remove_worker(w.identity, "disconnected", false);
+  } else {
+    ++shared_.unexpected;
+  }
+}
+
+void Broker::Loop::handle_result(Worker& w, const api::ResultMsg& r) {
+  ++shared_.results;
+  w.in_flight.erase(r.unit.attempt);
+  guarded("unit_done", [&] {
+    backend_.unit_done(w.id, key_of(r.unit), r.unit.attempt, api::payload_bytes(r.film_tile), r.paths);
+  });
+}
+
+void Broker::Loop::handle_failed(Worker& w, const api::FailedMsg& f) {
+  ++shared_.failures;
+  w.in_flight.erase(f.unit.attempt);
+  log("broker: worker " + w.id + " failed unit " + f.unit.job + "/" + std::to_string(f.unit.tile) + "/" +
+      std::to_string(f.unit.batch) + "/" + std::to_string(f.unit.pass) + ": " + f.message);
+  guarded("unit_failed", [&] { backend_.unit_failed(w.id, key_of(f.unit), f.unit.attempt, f.message); });
+}
+
+// --- Loop: workers ------------------------------------------------------------------
+
+void Broker::Loop::refuse(const std::string& identity, const std::string& reason) {
+  ++shared_.rejected;
+  log("broker: refused a worker: " + reason);
+  send(identity, api::DisconnectMsg{reason, true});
+  if (workers_.count(identity)) remove_worker(identity, "refused", false);
+}
+
+Clock::duration Broker::Loop::expiry_span(int worker_heartbeat_ms) const {
+  const Ms interval = std::max(options_.heartbeat_interval, Ms(worker_heartbeat_ms));
+  return interval * std::max(1, options_.heartbeat_liveness);
+}
+
+void Broker::Loop::register_worker(const std::string& identity, const api::ReadyMsg& ready) {
+  Worker w;
+  w.identity = identity;
+  w.id = ready.id;
+  w.slots = ready.slots;
+  w.expiry_span = expiry_span(ready.heartbeat_ms);
+  w.expiry = Clock::now() + w.expiry_span;
+  workers_[identity] = w;
+  identity_of_[ready.id] = identity;
+  ++shared_.workers;
+  ++shared_.joined;
+  nlohmann::json info{{"id", ready.id},
+                      {"cores", ready.cores},
+                      {"slots", ready.slots},
+                      {"version", ready.version},
+                      {"capabilities", ready.capabilities}};
+  if (ready.heartbeat_ms > 0) info["heartbeat_ms"] = ready.heartbeat_ms;
+  log("broker: worker " + ready.id + " joined (" + std::to_string(ready.cores) + " cores, " +
+      std::to_string(ready.slots) + " slots)");
+  guarded("worker_joined", [&] { backend_.worker_joined(ready.id, info); });
+  send_or_lose(identity, api::HeartbeatMsg{static_cast<int>(options_.heartbeat_interval.count()), false});
+}
+
+void Broker::Loop::remove_worker(const std::string& identity, const char* why, bool lost) {
+  const auto it = workers_.find(identity);
+  if (it == workers_.end()) return;
+  const std::string id = it->second.id;
+  const std::size_t held = it->second.in_flight.size();
+  workers_.erase(it);
+  if (const auto i = identity_of_.find(id); i != identity_of_.end() && i->second == identity) identity_of_.erase(i);
+  --shared_.workers;
+  ++shared_.left;
+  if (lost) ++shared_.lost;
+  log("broker: worker " + id + " left (" + why + ", " + std::to_string(held) + " units in flight)");
+  guarded("worker_left", [&] { backend_.worker_left(id); });
+}
+
+// --- Loop: periodic work -----------------------------------------------------------
+
+void Broker::Loop::heartbeat_all() {
+  const api::Message hb = api::HeartbeatMsg{static_cast<int>(options_.heartbeat_interval.count()), false};
+  std::vector<std::string> unreachable;
+  for (const auto& [identity, w] : workers_)
+    if (!send(identity, hb)) unreachable.push_back(identity);
+  for (const auto& identity : unreachable) remove_worker(identity, "unreachable", true);
+}
+
+void Broker::Loop::expire(Clock::time_point now) {
+  std::vector<std::string> expired;
+  for (const auto& [identity, w] : workers_)
+    if (w.expiry < now) expired.push_back(identity);
+  for (const auto& identity : expired) remove_worker(identity, "missed heartbeats", true);
+}
+
+void Broker::Loop::send_cancels() {
+  std::vector<std::pair<std::string, std::uint64_t>> cancels;
+  guarded("take_cancelled_attempts", [&] { cancels = backend_.take_cancelled_attempts(); });
+  for (const auto& [worker_id, attempt] : cancels) {
+    const auto i = identity_of_.find(worker_id);
+    if (i == identity_of_.end()) continue;  // gone: nothing to stop
+    const std::string identity = i->second;
+    Worker& w = workers_.at(identity);
+    if (!w.in_flight.erase(attempt)) continue;  // already answered
+    ++shared_.cancels_sent;
+    send_or_lose(identity, api::CancelMsg{attempt});
+  }
+}
+
+void Broker::Loop::dispatch() {
+  // Round-robin rounds of one unit per worker with credit, until nobody can
+  // take one or the backend has nothing for anyone.
+  for (bool progress = true; progress && !shared_.stop.load();) {
+    progress = false;
+    std::vector<std::string> ready;
+    for (const auto& [identity, w] : workers_)
+      if (w.has_credit()) ready.push_back(identity);
+    if (ready.empty()) return;
+    std::rotate(ready.begin(), ready.begin() + static_cast<std::ptrdiff_t>(round_robin_++ % ready.size()), ready.end());
+    for (const auto& identity : ready) {
+      const auto it = workers_.find(identity);
+      if (it == workers_.end() || !it->second.has_credit()) continue;
+      Worker& w = it->second;
+      std::optional<UnitAssignment> unit;
+      guarded("next_unit", [&] { unit = backend_.next_unit(w.id); });
+      if (!unit) continue;
+      w.in_flight[unit->attempt] = unit->key;
+      api::UnitMsg msg{{unit->key.job_id, unit->key.tile, unit->key.batch, unit->key.pass, unit->attempt},
+                       std::move(unit->request_canonical)};
+      if (!send(identity, msg)) {
+        remove_worker(identity, "unreachable", true);  // the backend requeues the unit
+        continue;
+      }
+      ++shared_.units_sent;
+      progress = true;
+    }
+  }
+}
+
+template <class F>
+void Broker::Loop::guarded(const char* what, F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    ++shared_.backend_errors;
+    log(std::string("broker: backend ") + what + " threw: " + e.what());
+  }
+}
+
+void Broker::Loop::log(const std::string& line) const {
+  if (options_.log) options_.log(line);
+  else std::cerr << line << "\n";
+}
+
+// --- Broker ------------------------------------------------------------------------
+
+Broker::Broker(BrokerBackend& backend, BrokerOptions options)
+    : backend_(backend), options_(std::move(options)), shared_(std::make_unique<Shared>()) {
+  if (options_.heartbeat_interval <= Ms(0)) options_.heartbeat_interval = Ms(1000);
+  if (options_.heartbeat_liveness < 1) options_.heartbeat_liveness = 1;
+  if (options_.poll_interval <= Ms(0)) options_.poll_interval = Ms(20);
+}
+
+Broker::~Broker() { stop(); }
+
+void Broker::start() {
+  if (thread_.joinable()) return;
+  shared_->stop.store(false);
+  loop_ = std::make_unique<Loop>(backend_, options_, *shared_);
+  bound_endpoint_ = loop_->bound();
+  thread_ = std::thread([loop = loop_.get()] { loop->run(); });
+}
+
+void Broker::stop() {
+  if (!thread_.joinable()) return;
+  shared_->stop.store(true);
+  shared_->wakeup.notify();
+  thread_.join();
+  loop_.reset();  // terminates the context: waits at most shutdown_linger
+}
+
+std::string Broker::bound_endpoint() const { return bound_endpoint_; }
+
+void Broker::wake() { shared_->wakeup.notify(); }
+
+BrokerStats Broker::stats() const {
+  const Shared& s = *shared_;
+  return BrokerStats{s.workers.load(),    s.joined.load(),       s.left.load(),         s.lost.load(),
+                     s.rejected.load(),   s.units_sent.load(),   s.results.load(),      s.failures.load(),
+                     s.cancels_sent.load(), s.malformed.load(),  s.unexpected.load(),   s.reregisters_sent.load(),
+                     s.backend_errors.load()};
+}
+
+}  // namespace skyfarm::server

@@ -1,0 +1,120 @@
+// The farm's ZeroMQ broker: one thread owning one ROUTER socket, between the
+// workers (DEALERs, api/wire.h protocol) and a BrokerBackend (the JobService,
+// or a fake in tests).  No other thread touches the socket; other threads
+// talk to the broker only through stop(), wake() and stats().
+//
+// Per worker (keyed by its ROUTER routing identity; its READY "id" is the
+// name the backend sees):
+//   handshake   READY (right version, right token when one is set) ->
+//               backend.worker_joined(id, header without the token) and an
+//               immediate HEARTBEAT; a wrong version or token gets a fatal
+//               DISCONNECT.  A READY whose id is already registered under
+//               another identity (a worker that reconnected) first ends the
+//               old registration (worker_left).  Any other message from an
+//               unknown peer is answered with REREGISTER.
+//   credit      the worker holds at most `slots` (its READY) units; a UNIT is
+//               sent only while it has a free slot (backend.next_unit), one
+//               unit per worker per round-robin round.  RESULT, FAILED and
+//               CANCEL free a slot; a draining worker (HEARTBEAT
+//               "draining") gets no more units.
+//   liveness    every message from the worker counts as a heartbeat; the
+//               broker heartbeats every worker each heartbeat_interval; a
+//               worker silent for heartbeat_liveness x max(own interval,
+//               worker's heartbeat_ms) is lost -> backend.worker_left.  So
+//               are DISCONNECT and a send that fails (EHOSTUNREACH under
+//               ROUTER_MANDATORY, or EAGAIN at the high-water mark: sends
+//               never block).
+//   results     RESULT -> backend.unit_done, FAILED -> backend.unit_failed,
+//               with the worker's (unit, attempt) as sent: results of stale
+//               or cancelled attempts are passed on (the backend drops
+//               them); the film-tile bytes are not decoded here.
+//   cancels     backend.take_cancelled_attempts() each tick -> CANCEL to the
+//               holders still connected (their slot is freed at once).
+//   timeouts    backend.check_timeouts(now) every timeout_check_interval.
+// Malformed or unexpected messages are counted (stats) and dropped; an
+// exception from the backend is logged and counted, never kills the thread.
+//
+// stop(): DISCONNECT to every worker, worker_left for each, close with a
+// short bounded linger (so the DISCONNECTs can leave; shutdown_linger), join,
+// terminate the context.  It never hangs on a dead peer.  A Broker may be
+// started again after stop() (a new socket and context).
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <thread>
+
+#include "server/job_service.h"
+
+namespace skyfarm::server {
+
+struct BrokerOptions {
+  // ZeroMQ endpoint to bind; "tcp://127.0.0.1:*" picks a free port (see bound_endpoint()).
+  std::string endpoint = "tcp://127.0.0.1:5555";
+  std::chrono::milliseconds heartbeat_interval{1000};
+  int heartbeat_liveness = 3;  // missed intervals before a worker is declared lost
+  // Shared secret every READY must carry ("token"); empty: none required.
+  std::string token;
+  // Longest wait in zmq_poll: the latency of stop(), of noticing cancels and
+  // of dispatching work that appears without wake() (capped at heartbeat_interval).
+  std::chrono::milliseconds poll_interval{20};
+  std::chrono::milliseconds timeout_check_interval{250};
+  std::chrono::milliseconds shutdown_linger{200};
+  std::size_t max_message_bytes = 64u << 20;  // ZMQ_MAXMSGSIZE: larger messages drop the peer's connection
+  // Log lines ("worker w1 joined (4 slots)"); empty: standard error.
+  std::function<void(std::string_view)> log;
+};
+
+// Counters since construction (thread-safe reads; "workers" is a gauge).
+struct BrokerStats {
+  std::uint64_t workers = 0;           // registered now
+  std::uint64_t joined = 0;            // READY accepted
+  std::uint64_t left = 0;              // worker_left calls (lost + disconnected)
+  std::uint64_t lost = 0;              // of which: missed heartbeats or failed sends
+  std::uint64_t rejected = 0;          // READY refused (token, version)
+  std::uint64_t units_sent = 0;
+  std::uint64_t results = 0;
+  std::uint64_t failures = 0;          // FAILED messages
+  std::uint64_t cancels_sent = 0;
+  std::uint64_t malformed = 0;         // undecodable messages
+  std::uint64_t unexpected = 0;        // valid messages a worker must not send (UNIT, CANCEL ...)
+  std::uint64_t reregisters_sent = 0;
+  std::uint64_t backend_errors = 0;    // exceptions thrown by the backend
+};
+
+class Broker {
+ public:
+  Broker(BrokerBackend& backend, BrokerOptions options = {});
+  ~Broker();  // stop()
+  Broker(const Broker&) = delete;
+  Broker& operator=(const Broker&) = delete;
+
+  // Binds the ROUTER (throws zmq::error_t or std::runtime_error when it
+  // cannot) and starts the broker thread.  No-op while running.
+  void start();
+  // Idempotent; returns within about shutdown_linger + poll_interval.
+  void stop();
+  bool running() const { return thread_.joinable(); }
+  // The endpoint actually bound (the port resolved), valid after start().
+  std::string bound_endpoint() const;
+  // Makes the broker thread dispatch now (e.g. after a job was submitted or
+  // cancelled) instead of at its next poll tick.  Thread-safe, cheap.
+  void wake();
+  BrokerStats stats() const;
+
+ private:
+  struct Loop;
+  struct Shared;
+  BrokerBackend& backend_;
+  BrokerOptions options_;
+  std::unique_ptr<Shared> shared_;  // stop flag, wake-up pipe, counters
+  std::unique_ptr<Loop> loop_;
+  std::thread thread_;
+  std::string bound_endpoint_;
+};
+
+}  // namespace skyfarm::server

@@ -1,0 +1,332 @@
+// The ZeroMQ broker (server/broker.h) driven by raw DEALER peers over
+// loopback: handshake, credit, heartbeats and expiry, REREGISTER, stale
+// attempts, CANCEL, tokens, malformed input and shutdown.  Each test is
+// bounded by short heartbeats (100 ms) and deadline waits.
+#include "server/broker.h"
+
+#include <gtest/gtest.h>
+
+#include <thread>
+
+#include "tests/server/fake_broker_backend.h"
+
+namespace skyfarm::server {
+namespace {
+
+using namespace std::chrono_literals;
+using skyfarm::testing::eventually;
+using skyfarm::testing::FakeBackend;
+using skyfarm::testing::RawPeer;
+
+BrokerOptions test_options() {
+  BrokerOptions o;
+  o.endpoint = "tcp://127.0.0.1:*";
+  o.heartbeat_interval = 100ms;
+  o.heartbeat_liveness = 3;
+  o.log = [](std::string_view) {};
+  return o;
+}
+
+class BrokerTest : public ::testing::Test {
+ protected:
+  void start(BrokerOptions o = test_options()) {
+    broker_ = std::make_unique<Broker>(backend_, o);
+    broker_->start();
+  }
+  std::unique_ptr<RawPeer> peer() { return std::make_unique<RawPeer>(ctx_, broker_->bound_endpoint()); }
+  // A registered peer (READY answered).
+  std::unique_ptr<RawPeer> joined_peer(const std::string& id, int slots = 1) {
+    auto p = peer();
+    p->send(RawPeer::ready(id, slots));
+    EXPECT_TRUE(p->receive_a<api::HeartbeatMsg>().has_value()) << "no welcome heartbeat";
+    return p;
+  }
+  void TearDown() override {
+    if (broker_) broker_->stop();
+  }
+
+  zmq::context_t ctx_;
+  FakeBackend backend_;
+  std::unique_ptr<Broker> broker_;
+};
+
+TEST_F(BrokerTest, BindsAWildcardPortAndStopsQuickly) {
+  start();
+  const std::string ep = broker_->bound_endpoint();
+  EXPECT_EQ(ep.rfind("tcp://127.0.0.1:", 0), 0u) << ep;
+  EXPECT_EQ(ep.find('*'), std::string::npos) << ep;
+  const auto t0 = std::chrono::steady_clock::now();
+  broker_->stop();
+  EXPECT_LT(std::chrono::steady_clock::now() - t0, 1s);
+  EXPECT_FALSE(broker_->running());
+  broker_->stop();  // idempotent
+}
+
+TEST_F(BrokerTest, ReadyJoinsTheWorkerWithoutItsToken) {
+  BrokerOptions o = test_options();
+  o.token = "s3cret";
+  start(o);
+  auto p = peer();
+  api::ReadyMsg r = RawPeer::ready("w1", 3);
+  r.token = "s3cret";
+  p->send(r);
+  ASSERT_TRUE(p->receive_a<api::HeartbeatMsg>());
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.joined.size() == 1; }));
+  backend_.with_lock([](auto& b) {
+    const auto& [id, info] = b.joined[0];
+    EXPECT_EQ(id, "w1");
+    EXPECT_EQ(info["slots"], 3);
+    EXPECT_EQ(info["cores"], 1);
+    EXPECT_EQ(info["version"], api::kProtocolVersion);
+    EXPECT_EQ(info["capabilities"]["spectral"], true);
+    EXPECT_FALSE(info.contains("token"));
+    return 0;
+  });
+  EXPECT_EQ(broker_->stats().workers, 1u);
+}
+
+TEST_F(BrokerTest, WrongTokenOrVersionIsRefusedWithAFatalDisconnect) {
+  BrokerOptions o = test_options();
+  o.token = "s3cret";
+  start(o);
+  auto p = peer();
+  api::ReadyMsg r = RawPeer::ready("w1");
+  r.token = "guess";
+  p->send(r);
+  auto bye = p->receive_a<api::DisconnectMsg>();
+  ASSERT_TRUE(bye);
+  EXPECT_TRUE(bye->fatal);
+  r.token.reset();
+  p->send(r);
+  ASSERT_TRUE(p->receive_a<api::DisconnectMsg>());
+  r.token = "s3cret";
+  r.version = api::kProtocolVersion + 1;
+  p->send(r);
+  bye = p->receive_a<api::DisconnectMsg>();
+  ASSERT_TRUE(bye);
+  EXPECT_NE(bye->reason.find("version"), std::string::npos);
+  EXPECT_EQ(broker_->stats().rejected, 3u);
+  EXPECT_TRUE(backend_.with_lock([](auto& b) { return b.joined.empty(); }));
+}
+
+TEST_F(BrokerTest, UnknownPeerIsAskedToReregister) {
+  start();
+  auto p = peer();
+  p->send(api::HeartbeatMsg{});
+  EXPECT_TRUE(p->receive_a<api::ReregisterMsg>());
+  api::ResultMsg result;
+  result.unit = {"j", 0, 0, 0, 9};
+  result.film_tile = "bytes";
+  p->send(result);
+  EXPECT_TRUE(p->receive_a<api::ReregisterMsg>());
+  EXPECT_TRUE(backend_.with_lock([](auto& b) { return b.done.empty(); }));  // not from a stranger
+}
+
+TEST_F(BrokerTest, CreditLimitsUnitsToTheWorkersSlots) {
+  start();
+  for (int i = 0; i < 3; ++i) backend_.add_unit("j", i, 0, 0, "{}");
+  auto p = joined_peer("w1", 1);
+  auto u = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  EXPECT_EQ(u->unit.tile, 0);
+  EXPECT_EQ(u->request, "{}");
+  EXPECT_FALSE(p->receive_a<api::UnitMsg>(300ms)) << "a second unit beyond the worker's 1 slot";
+  p->send(api::ResultMsg{u->unit, 10, 0.01, "tile"});
+  auto u2 = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u2);
+  EXPECT_EQ(u2->unit.tile, 1);
+  EXPECT_NE(u2->unit.attempt, u->unit.attempt);
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.done.size() == 1; }));
+  backend_.with_lock([&](auto& b) {
+    EXPECT_EQ(b.done[0].worker, "w1");
+    EXPECT_EQ(b.done[0].attempt, u->unit.attempt);
+    EXPECT_EQ(b.done[0].paths, 10u);
+    EXPECT_EQ(std::string(b.done[0].bytes.begin(), b.done[0].bytes.end()), "tile");
+    EXPECT_EQ(b.max_held["w1"], 1);
+    return 0;
+  });
+}
+
+TEST_F(BrokerTest, SlotsAreFilledAndFailuresFreeThem) {
+  start();
+  for (int i = 0; i < 4; ++i) backend_.add_unit("j", i, 0, 0, "{}");
+  auto p = joined_peer("w1", 3);
+  std::vector<api::UnitMsg> units;
+  for (int i = 0; i < 3; ++i) {
+    auto u = p->receive_a<api::UnitMsg>();
+    ASSERT_TRUE(u);
+    units.push_back(*u);
+  }
+  EXPECT_FALSE(p->receive_a<api::UnitMsg>(200ms));
+  p->send(api::FailedMsg{units[1].unit, "out of memory"});
+  ASSERT_TRUE(p->receive_a<api::UnitMsg>());
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.failed.size() == 1; }));
+  backend_.with_lock([&](auto& b) {
+    EXPECT_EQ(b.failed[0].attempt, units[1].unit.attempt);
+    EXPECT_EQ(b.failed[0].message, "out of memory");
+    EXPECT_EQ(b.failed[0].key, (UnitKey{"j", 1, 0, 0}));
+    return 0;
+  });
+}
+
+TEST_F(BrokerTest, SilentWorkerExpiresAndItsUnitsAreRequeued) {
+  start();
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  auto p = joined_peer("w1", 1);
+  ASSERT_TRUE(p->receive_a<api::UnitMsg>());
+  const auto t0 = std::chrono::steady_clock::now();
+  // No more messages from the peer: 3 x 100 ms later it is lost.
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.left.size() == 1; }, 3s));
+  const auto waited = std::chrono::steady_clock::now() - t0;
+  EXPECT_GE(waited, 200ms);
+  EXPECT_LT(waited, 1500ms);
+  EXPECT_EQ(broker_->stats().lost, 1u);
+  EXPECT_EQ(backend_.with_lock([](auto& b) { return b.queue_.size(); }), 1u);
+  // Once forgotten, its heartbeat is answered with REREGISTER.
+  p->send(api::HeartbeatMsg{});
+  EXPECT_TRUE(p->receive_a<api::ReregisterMsg>());
+}
+
+TEST_F(BrokerTest, HeartbeatingWorkerStaysAndIsHeartbeated) {
+  start();
+  auto p = joined_peer("w1", 1);
+  int heartbeats = 0;
+  const auto until = std::chrono::steady_clock::now() + 700ms;
+  while (std::chrono::steady_clock::now() < until) {
+    p->send(api::HeartbeatMsg{100, false});
+    if (p->receive_a<api::HeartbeatMsg>(100ms)) ++heartbeats;
+  }
+  EXPECT_GE(heartbeats, 4);
+  EXPECT_TRUE(backend_.with_lock([](auto& b) { return b.left.empty(); }));
+}
+
+TEST_F(BrokerTest, StaleAttemptResultsReachTheBackendWithTheirIds) {
+  start();
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  auto p = joined_peer("w1", 1);
+  auto u = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  api::UnitRef stale = u->unit;
+  stale.attempt += 100;
+  p->send(api::ResultMsg{stale, 1, 0.1, "old"});
+  p->send(api::ResultMsg{u->unit, 1, 0.1, "new"});
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.done.size() == 2; }));
+  backend_.with_lock([&](auto& b) {
+    EXPECT_EQ(b.done[0].attempt, stale.attempt);
+    EXPECT_EQ(b.done[1].attempt, u->unit.attempt);
+    return 0;
+  });
+}
+
+TEST_F(BrokerTest, CancelReachesTheHolderAndFreesItsSlot) {
+  start();
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  backend_.add_unit("j", 1, 0, 0, "{}");
+  auto p = joined_peer("w1", 1);
+  auto u = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  backend_.cancel(u->unit.attempt);
+  auto c = p->receive_a<api::CancelMsg>();
+  ASSERT_TRUE(c);
+  EXPECT_EQ(c->attempt, u->unit.attempt);
+  auto next = p->receive_a<api::UnitMsg>();  // the slot is free again
+  ASSERT_TRUE(next);
+  EXPECT_EQ(next->unit.tile, 1);
+  EXPECT_EQ(broker_->stats().cancels_sent, 1u);
+}
+
+TEST_F(BrokerTest, DrainingWorkerGetsNoMoreUnits) {
+  start();
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  backend_.add_unit("j", 1, 0, 0, "{}");
+  auto p = joined_peer("w1", 1);
+  auto u = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  p->send(api::HeartbeatMsg{100, true});
+  p->send(api::ResultMsg{u->unit, 1, 0.1, "tile"});
+  EXPECT_FALSE(p->receive_a<api::UnitMsg>(300ms));
+  p->send(api::DisconnectMsg{"worker draining", false});
+  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.left.size() == 1; }));
+  backend_.with_lock([](auto& b) {
+    EXPECT_EQ(b.done.size(), 1u);
+    EXPECT_EQ(b.queue_.size(), 1u);
+    return 0;
+  });
+}
+
+TEST_F(BrokerTest, DisconnectAndReconnectWithTheSameIdReplaceTheRegistration) {
+  start();
+  auto a = joined_peer("w1", 1);
+  auto b = joined_peer("w1", 1);  // the same worker on a new socket
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.joined.size() == 2 && f.left.size() == 1; }));
+  EXPECT_EQ(broker_->stats().workers, 1u);
+  b->send(api::DisconnectMsg{});
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.left.size() == 2; }));
+  EXPECT_EQ(broker_->stats().workers, 0u);
+}
+
+TEST_F(BrokerTest, MalformedFramesAreCountedAndDropped) {
+  start();
+  auto raw = peer();
+  const std::vector<api::Frames> garbage = {
+      {""},
+      {"READY"},
+      {"READY", "{bad json"},
+      {"READY", "[]"},
+      {"READY", R"({"id": "x", "cores": -1, "slots": 1, "version": 1})"},
+      {"RESULT", R"({"job": "j"})"},
+      {"HELLO", "{}"},
+      {std::string(1000, '\xff'), std::string(5000, '\0')},
+      {"CANCEL", std::string(50000, '{')},
+      {"UNIT", "{}", "a", "b", "c", "d"},
+  };
+  for (const auto& g : garbage) raw->send_frames(g);
+  ASSERT_TRUE(eventually([&] { return broker_->stats().malformed >= garbage.size(); }, 2s))
+      << broker_->stats().malformed;
+  // Still serving: a proper READY on the same socket is accepted.
+  raw->send(RawPeer::ready("after-garbage"));
+  EXPECT_TRUE(raw->receive_a<api::HeartbeatMsg>());
+  EXPECT_TRUE(backend_.wait_for([](auto& b) { return b.joined.size() == 1; }));
+  // Valid messages a worker must not send are counted too.
+  api::UnitMsg unit;
+  unit.unit = {"j", 0, 0, 0, 1};
+  unit.request = "{}";
+  raw->send(unit);
+  raw->send(api::CancelMsg{1});
+  EXPECT_TRUE(eventually([&] { return broker_->stats().unexpected == 2; }, 2s));
+}
+
+TEST_F(BrokerTest, StopSendsDisconnectAndWorkerLeft) {
+  start();
+  auto p = joined_peer("w1", 1);
+  broker_->stop();
+  auto bye = p->receive_a<api::DisconnectMsg>();
+  ASSERT_TRUE(bye);
+  EXPECT_FALSE(bye->fatal);
+  EXPECT_EQ(backend_.with_lock([](auto& b) { return b.left.size(); }), 1u);
+}
+
+// A backend whose every call throws: the broker logs, counts and carries on.
+class ThrowingBackend : public FakeBackend {
+ public:
+  std::optional<UnitAssignment> next_unit(const std::string&) override { throw std::runtime_error("db down"); }
+  void worker_joined(const std::string&, const nlohmann::json&) override { throw std::runtime_error("db down"); }
+};
+
+TEST(BrokerBackendErrors, ExceptionsFromTheBackendDoNotStopTheBroker) {
+  ThrowingBackend backend;
+  BrokerOptions o = test_options();
+  Broker broker(backend, o);
+  broker.start();
+  zmq::context_t ctx;
+  RawPeer p(ctx, broker.bound_endpoint());
+  p.send(RawPeer::ready("w1"));
+  EXPECT_TRUE(p.receive_a<api::HeartbeatMsg>());
+  std::this_thread::sleep_for(100ms);
+  EXPECT_GE(broker.stats().backend_errors, 2u);
+  EXPECT_TRUE(broker.running());
+  broker.stop();
+}
+
+}  // namespace
+}  // namespace skyfarm::server

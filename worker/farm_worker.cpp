@@ -1,0 +1,527 @@
+#include "worker/farm_worker.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <iostream>
+#include <list>
+#include <map>
+#include <mutex>
+#include <random>
+#include <thread>
+#include <vector>
+
+#include <zmq.hpp>
+#include <zmq_addon.hpp>
+
+#include "api/render_request.h"
+#include "api/render_setup.h"
+#include "api/wire.h"
+#include "common/film/film_tile.h"
+#include "common/render/parallel.h"
+#include "common/render/tile_renderer.h"
+
+namespace skyfarm {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Ms = std::chrono::milliseconds;
+
+constexpr Ms kMaxTick{100};  // longest poll: latency of drain_flag and of pause changes
+
+// --- Setup cache ----------------------------------------------------------------
+
+// What renders the units of one job.
+struct JobRenderer {
+  api::RenderSetup setup;
+  std::unique_ptr<TileRenderer> renderer;
+};
+
+// LRU of job id -> JobRenderer, shared by the render threads.  Each entry is
+// built once (under its own mutex, so threads rendering other jobs do not
+// wait); a request that cannot be set up caches its error.
+class SetupCache {
+ public:
+  explicit SetupCache(std::size_t capacity) : capacity_(std::max<std::size_t>(1, capacity)) {}
+
+  // Throws std::runtime_error with the reason when the request cannot be rendered.
+  std::shared_ptr<const JobRenderer> get(const std::string& job, const std::string& request) {
+    const std::shared_ptr<Entry> e = entry(job, request);
+    std::lock_guard lock(e->mutex);
+    if (!e->built) build(*e);
+    if (!e->error.empty()) throw std::runtime_error(e->error);
+    return {e, &e->job};
+  }
+
+ private:
+  struct Entry {
+    std::string request;
+    std::mutex mutex;
+    bool built = false;
+    std::string error;
+    JobRenderer job;
+  };
+
+  std::shared_ptr<Entry> entry(const std::string& job, const std::string& request) {
+    std::lock_guard lock(mutex_);
+    const auto it = std::find_if(lru_.begin(), lru_.end(), [&](const auto& p) { return p.first == job; });
+    if (it != lru_.end() && it->second->request == request) {
+      lru_.splice(lru_.begin(), lru_, it);
+      return lru_.front().second;
+    }
+    if (it != lru_.end()) lru_.erase(it);
+    auto e = std::make_shared<Entry>();
+    e->request = request;
+    lru_.emplace_front(job, e);
+    while (lru_.size() > capacity_) lru_.pop_back();  // in-use entries live on in their users
+    return e;
+  }
+
+  static void build(Entry& e) {
+    e.built = true;
+    try {
+      const api::RenderRequest request = api::parse_render_request(e.request);
+      if (request.method != api::Method::kPath) {
+        e.error = "method \"lut\" is not available on this worker; use \"path\"";
+        return;
+      }
+      e.job.setup = api::make_render_setup(request);
+      e.job.renderer = std::make_unique<TileRenderer>(*e.job.setup.scene, *e.job.setup.camera, e.job.setup.plan);
+    } catch (const api::ValidationError& ex) {
+      e.error = std::string("invalid request: ") + ex.what();
+    } catch (const std::exception& ex) {
+      e.error = std::string("cannot set up the render: ") + ex.what();
+    }
+  }
+
+  std::mutex mutex_;
+  std::list<std::pair<std::string, std::shared_ptr<Entry>>> lru_;  // most recent first
+  std::size_t capacity_;
+};
+
+// --- Render pool ------------------------------------------------------------------
+
+struct RenderTask {
+  std::uint64_t session = 0;
+  api::UnitMsg unit;
+};
+
+struct RenderOutcome {
+  std::uint64_t session = 0;
+  std::uint64_t attempt = 0;
+  api::Message message;  // ResultMsg or FailedMsg
+};
+
+api::Message render_unit_message(SetupCache& cache, const api::UnitMsg& task) {
+  const auto t0 = Clock::now();
+  try {
+    const auto job = cache.get(task.unit.job, task.request);
+    const RenderPlan& plan = job->renderer->plan();
+    const api::UnitRef& u = task.unit;
+    if (u.tile >= plan.tile_count() || u.batch >= plan.batches || u.pass >= plan.passes)
+      throw std::runtime_error("unit (tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) +
+                               ", pass " + std::to_string(u.pass) + ") is outside the job's plan");
+    FilmTile film = job->renderer->empty_tile(u.tile);
+    PathCounters counters;
+    job->renderer->render_unit(WorkUnit{u.tile, u.batch, u.pass}, &film, &counters);
+    const std::vector<std::uint8_t> bytes = film.serialize();
+    const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    return api::ResultMsg{u, counters.paths, seconds, std::string(bytes.begin(), bytes.end())};
+  } catch (const std::exception& e) {
+    return api::FailedMsg{task.unit, e.what()};
+  }
+}
+
+// `threads` render threads taking tasks in arrival order; outcomes are queued
+// for the I/O thread, which is woken through the pipe.
+class RenderPool {
+ public:
+  RenderPool(int threads, std::size_t cache_jobs, const api::WakeupPipe& wakeup)
+      : cache_(cache_jobs), wakeup_(wakeup) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
+  }
+  ~RenderPool() { stop(); }
+
+  void push(RenderTask task) {
+    {
+      std::lock_guard lock(mutex_);
+      tasks_.push_back(std::move(task));
+    }
+    cv_.notify_one();
+  }
+  // Drops a task that has not started; false if none matched.
+  bool remove(std::uint64_t session, std::uint64_t attempt) {
+    std::lock_guard lock(mutex_);
+    const auto it = std::find_if(tasks_.begin(), tasks_.end(), [&](const RenderTask& t) {
+      return t.session == session && t.unit.unit.attempt == attempt;
+    });
+    if (it == tasks_.end()) return false;
+    tasks_.erase(it);
+    return true;
+  }
+  void clear_queue() {
+    std::lock_guard lock(mutex_);
+    tasks_.clear();
+  }
+  std::vector<RenderOutcome> take_outcomes() {
+    std::lock_guard lock(mutex_);
+    std::vector<RenderOutcome> out(std::make_move_iterator(outcomes_.begin()), std::make_move_iterator(outcomes_.end()));
+    outcomes_.clear();
+    return out;
+  }
+  // Units in progress finish first (render_unit cannot be interrupted).
+  void stop() {
+    {
+      std::lock_guard lock(mutex_);
+      stopping_ = true;
+      tasks_.clear();
+    }
+    cv_.notify_all();
+    for (auto& t : threads_)
+      if (t.joinable()) t.join();
+  }
+
+ private:
+  void work() {
+    for (;;) {
+      RenderTask task;
+      {
+        std::unique_lock lock(mutex_);
+        cv_.wait(lock, [&] { return stopping_ || !tasks_.empty(); });
+        if (stopping_) return;
+        task = std::move(tasks_.front());
+        tasks_.pop_front();
+      }
+      RenderOutcome outcome{task.session, task.unit.unit.attempt, render_unit_message(cache_, task.unit)};
+      {
+        std::lock_guard lock(mutex_);
+        outcomes_.push_back(std::move(outcome));
+      }
+      wakeup_.notify();
+    }
+  }
+
+  SetupCache cache_;
+  const api::WakeupPipe& wakeup_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<RenderTask> tasks_;
+  std::deque<RenderOutcome> outcomes_;
+  bool stopping_ = false;
+  std::vector<std::thread> threads_;
+};
+
+// How a session (one socket's life) ended.
+enum class SessionEnd { kDrained, kRefused, kServerGone };
+
+}  // namespace
+
+// --- FarmWorker::Impl -----------------------------------------------------------------
+
+struct FarmWorker::Impl {
+  explicit Impl(FarmWorkerOptions o);
+
+  int run();
+  bool drain_requested() const {
+    return drain.load() || (options.drain_flag != nullptr && options.drain_flag->load());
+  }
+
+  FarmWorkerOptions options;
+  int threads = 1;
+  int slots = 2;
+  std::atomic<bool> drain{false};
+  std::atomic<bool> paused{false};
+  std::atomic<bool> running{false};
+  api::WakeupPipe wakeup;
+  struct Counters {
+    std::atomic<std::uint64_t> sessions{0}, units_received{0}, results_sent{0}, failures_sent{0},
+        cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0};
+  } counters;
+
+ private:
+  // --- sessions
+  SessionEnd serve(zmq::socket_t& socket);
+  std::optional<SessionEnd> handle(zmq::socket_t& socket, const api::Message& message);
+  void send_ready(zmq::socket_t& socket);
+  void abandon_units();
+  bool wait_backoff(Ms delay);
+  // --- units
+  void accept_unit(const api::UnitMsg& unit);
+  void forward_outcomes(zmq::socket_t& socket);
+  // --- plumbing
+  bool send(zmq::socket_t& socket, const api::Message& message);
+  std::optional<api::Message> receive(zmq::socket_t& socket);
+  api::HeartbeatMsg heartbeat() const;
+  void log(const std::string& line) const;
+
+  std::unique_ptr<RenderPool> pool_;
+  std::uint64_t session_ = 0;                      // abandons renders of earlier sessions
+  std::map<std::uint64_t, api::UnitRef> units_;  // attempt -> unit held in this session
+  bool draining_ = false;
+  bool heard_server_ = false;                     // this session got a message
+  Clock::duration server_span_{};
+  Clock::time_point server_expiry_{}, next_heartbeat_{};
+};
+
+FarmWorker::Impl::Impl(FarmWorkerOptions o) : options(std::move(o)) {
+  threads = resolve_thread_count(options.threads);
+  slots = options.slots > 0 ? std::min(options.slots, api::kMaxSlots) : std::min(threads + 1, api::kMaxSlots);
+  if (options.id.empty()) options.id = default_worker_id();
+  if (options.heartbeat_interval <= Ms(0)) options.heartbeat_interval = Ms(1000);
+  options.heartbeat_liveness = std::max(1, options.heartbeat_liveness);
+  if (options.reconnect_initial <= Ms(0)) options.reconnect_initial = Ms(1000);
+  options.reconnect_max = std::max(options.reconnect_max, options.reconnect_initial);
+}
+
+int FarmWorker::Impl::run() {
+  if (running.exchange(true)) throw std::logic_error("FarmWorker::run called twice");
+  pool_ = std::make_unique<RenderPool>(threads, static_cast<std::size_t>(options.setup_cache_jobs), wakeup);
+  log("worker " + options.id + ": " + std::to_string(threads) + " render threads, " + std::to_string(slots) +
+      " slots, server " + options.endpoint);
+  zmq::context_t ctx(1);
+  Ms backoff = options.reconnect_initial;
+  int rc = 0;
+  for (;;) {
+    if (drain_requested()) break;  // not connected: nothing to hand back
+    zmq::socket_t socket(ctx, zmq::socket_type::dealer);
+    socket.set(zmq::sockopt::linger, 0);
+    socket.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64) << 20);
+    socket.connect(options.endpoint);
+    const SessionEnd end = serve(socket);
+    if (end == SessionEnd::kDrained && heard_server_)  // let the results and DISCONNECT leave
+      socket.set(zmq::sockopt::linger, static_cast<int>(options.drain_linger.count()));
+    socket.close();
+    if (end == SessionEnd::kDrained) break;
+    if (end == SessionEnd::kRefused) {
+      rc = 1;
+      break;
+    }
+    abandon_units();
+    if (heard_server_) backoff = options.reconnect_initial;
+    if (!wait_backoff(backoff)) break;
+    backoff = std::min(backoff * 2, options.reconnect_max);
+  }
+  pool_->stop();
+  return rc;  // ctx terminates here: queued results and DISCONNECT get drain_linger to leave
+}
+
+// Sleeps `delay` unless a drain is requested first (then false).
+bool FarmWorker::Impl::wait_backoff(Ms delay) {
+  log("worker " + options.id + ": server lost; reconnecting in " + std::to_string(delay.count()) + " ms");
+  const auto until = Clock::now() + delay;
+  while (!drain_requested()) {
+    const auto left = std::chrono::duration_cast<Ms>(until - Clock::now());
+    if (left <= Ms(0)) return true;
+    zmq::pollitem_t item{nullptr, wakeup.read_fd(), ZMQ_POLLIN, 0};
+    try {
+      zmq::poll(&item, 1, std::min(left, kMaxTick));
+    } catch (const zmq::error_t&) {  // EINTR
+    }
+    wakeup.drain();
+    counters.results_dropped += pool_->take_outcomes().size();
+  }
+  return false;
+}
+
+// --- Sessions ---------------------------------------------------------------------------
+
+SessionEnd FarmWorker::Impl::serve(zmq::socket_t& socket) {
+  heard_server_ = false;
+  draining_ = false;
+  server_span_ = options.heartbeat_interval * options.heartbeat_liveness;
+  send_ready(socket);
+  for (;;) {
+    if (paused.load()) {
+      std::this_thread::sleep_for(Ms(10));
+      continue;
+    }
+    zmq::pollitem_t items[] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {nullptr, wakeup.read_fd(), ZMQ_POLLIN, 0}};
+    const auto to_heartbeat = std::chrono::duration_cast<Ms>(next_heartbeat_ - Clock::now());
+    try {
+      zmq::poll(items, 2, std::clamp(to_heartbeat, Ms(0), kMaxTick));
+    } catch (const zmq::error_t& e) {
+      if (e.num() != EINTR) throw;
+    }
+    if (items[1].revents & ZMQ_POLLIN) wakeup.drain();
+    for (int i = 0; i < 1000; ++i) {  // bounded: heartbeats must go out whatever arrives
+      const std::optional<api::Message> message = receive(socket);
+      if (!message) break;
+      if (const auto end = handle(socket, *message)) return *end;
+    }
+    forward_outcomes(socket);
+    if (drain_requested() && !draining_) {
+      draining_ = true;
+      log("worker " + options.id + ": draining (" + std::to_string(units_.size()) + " units to finish)");
+      send(socket, heartbeat());
+    }
+    if (draining_ && units_.empty()) {
+      send(socket, api::DisconnectMsg{"worker draining", false});
+      return SessionEnd::kDrained;
+    }
+    const auto now = Clock::now();
+    if (now >= next_heartbeat_) {
+      send(socket, heartbeat());
+      next_heartbeat_ = now + options.heartbeat_interval;
+    }
+    if (now > server_expiry_) return SessionEnd::kServerGone;
+  }
+}
+
+std::optional<SessionEnd> FarmWorker::Impl::handle(zmq::socket_t& socket, const api::Message& message) {
+  if (const auto* hb = std::get_if<api::HeartbeatMsg>(&message)) {
+    if (hb->heartbeat_ms > 0)
+      server_span_ = std::max(options.heartbeat_interval, Ms(hb->heartbeat_ms)) * options.heartbeat_liveness;
+    server_expiry_ = Clock::now() + server_span_;
+  } else if (const auto* unit = std::get_if<api::UnitMsg>(&message)) {
+    accept_unit(*unit);
+  } else if (const auto* cancel = std::get_if<api::CancelMsg>(&message)) {
+    ++counters.cancels_received;
+    if (units_.erase(cancel->attempt)) pool_->remove(session_, cancel->attempt);
+  } else if (const auto* bye = std::get_if<api::DisconnectMsg>(&message)) {
+    log("worker " + options.id + ": server disconnected" + (bye->reason.empty() ? "" : ": " + bye->reason));
+    return bye->fatal ? SessionEnd::kRefused : SessionEnd::kServerGone;
+  } else if (std::holds_alternative<api::ReregisterMsg>(message)) {
+    abandon_units();
+    if (draining_) return SessionEnd::kDrained;  // the server holds nothing of ours
+    send_ready(socket);
+  } else {
+    ++counters.malformed;  // READY, RESULT, FAILED: not for a worker
+  }
+  return std::nullopt;
+}
+
+void FarmWorker::Impl::send_ready(zmq::socket_t& socket) {
+  api::ReadyMsg ready;
+  ready.id = options.id;
+  ready.cores = threads;
+  ready.slots = slots;
+  ready.capabilities = {{"spectral", true}, {"methods", {"path"}}};
+  ready.heartbeat_ms = static_cast<int>(options.heartbeat_interval.count());
+  if (!options.token.empty()) ready.token = options.token;
+  ++counters.sessions;
+  send(socket, ready);
+  const auto now = Clock::now();
+  server_expiry_ = now + server_span_;
+  next_heartbeat_ = now + options.heartbeat_interval;
+}
+
+// The server requeues what we held: forget it (renders in progress finish unseen).
+void FarmWorker::Impl::abandon_units() {
+  ++session_;
+  units_.clear();
+  pool_->clear_queue();
+}
+
+// --- Units -------------------------------------------------------------------------------
+
+void FarmWorker::Impl::accept_unit(const api::UnitMsg& unit) {
+  ++counters.units_received;
+  if (!units_.emplace(unit.unit.attempt, unit.unit).second) return;  // a duplicate dispatch
+  pool_->push(RenderTask{session_, unit});
+}
+
+void FarmWorker::Impl::forward_outcomes(zmq::socket_t& socket) {
+  for (RenderOutcome& o : pool_->take_outcomes()) {
+    if (o.session != session_ || units_.erase(o.attempt) == 0) {
+      ++counters.results_dropped;  // cancelled, or from an abandoned session
+      continue;
+    }
+    const bool ok = std::holds_alternative<api::ResultMsg>(o.message);
+    if (!ok) log("worker " + options.id + ": unit failed: " + std::get<api::FailedMsg>(o.message).message);
+    if (send(socket, o.message)) ++(ok ? counters.results_sent : counters.failures_sent);
+  }
+}
+
+// --- Plumbing ------------------------------------------------------------------------------
+
+bool FarmWorker::Impl::send(zmq::socket_t& socket, const api::Message& message) {
+  const api::Frames frames = api::encode(message);
+  try {
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const auto more = i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none;
+      if (!socket.send(zmq::buffer(frames[i]), more | zmq::send_flags::dontwait)) {
+        ++counters.send_failures;  // EAGAIN on the first frame: the queue is full
+        return false;
+      }
+    }
+    return true;
+  } catch (const zmq::error_t& e) {
+    ++counters.send_failures;
+    log(std::string("worker: send failed: ") + e.what());
+    return false;
+  }
+}
+
+// The next message from the server, nullopt when none is waiting; a
+// malformed one is counted and skipped (it still proves the server alive).
+std::optional<api::Message> FarmWorker::Impl::receive(zmq::socket_t& socket) {
+  for (;;) {
+    std::vector<zmq::message_t> parts;
+    try {
+      if (!zmq::recv_multipart(socket, std::back_inserter(parts), zmq::recv_flags::dontwait)) return std::nullopt;
+    } catch (const zmq::error_t& e) {
+      if (e.num() == EINTR) continue;
+      throw;
+    }
+    heard_server_ = true;
+    server_expiry_ = Clock::now() + server_span_;
+    api::Frames frames;
+    for (auto& p : parts) frames.push_back(p.to_string());
+    std::string error;
+    if (auto message = api::try_decode(frames, &error)) return message;
+    ++counters.malformed;
+    log("worker " + options.id + ": dropped a malformed message from the server: " + error);
+  }
+}
+
+api::HeartbeatMsg FarmWorker::Impl::heartbeat() const {
+  return api::HeartbeatMsg{static_cast<int>(options.heartbeat_interval.count()), draining_};
+}
+
+void FarmWorker::Impl::log(const std::string& line) const {
+  if (options.log) options.log(line);
+  else std::cerr << "skyfarm-worker: " << line << "\n";
+}
+
+// --- FarmWorker -------------------------------------------------------------------------
+
+FarmWorker::FarmWorker(FarmWorkerOptions options) : impl_(std::make_unique<Impl>(std::move(options))) {}
+FarmWorker::~FarmWorker() = default;
+
+int FarmWorker::run() { return impl_->run(); }
+
+void FarmWorker::request_drain() {
+  impl_->drain.store(true);
+  impl_->wakeup.notify();
+}
+
+const std::string& FarmWorker::id() const { return impl_->options.id; }
+int FarmWorker::threads() const { return impl_->threads; }
+int FarmWorker::slots() const { return impl_->slots; }
+
+FarmWorkerStats FarmWorker::stats() const {
+  const auto& c = impl_->counters;
+  return FarmWorkerStats{c.sessions.load(),         c.units_received.load(),  c.results_sent.load(),
+                         c.failures_sent.load(),    c.cancels_received.load(), c.results_dropped.load(),
+                         c.malformed.load(),        c.send_failures.load()};
+}
+
+void FarmWorker::set_paused_for_testing(bool paused) {
+  impl_->paused.store(paused);
+  impl_->wakeup.notify();
+}
+
+std::string default_worker_id() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0 || host[0] == '\0') std::snprintf(host, sizeof host, "worker");
+  std::random_device rd;
+  char suffix[16];
+  std::snprintf(suffix, sizeof suffix, "%04x", static_cast<unsigned>(rd() & 0xffffu));
+  return std::string(host) + "-" + std::to_string(::getpid()) + "-" + suffix;
+}
+
+}  // namespace skyfarm

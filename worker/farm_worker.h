@@ -1,0 +1,118 @@
+// The farm worker: `skyfarm-worker --connect tcp://HOST:PORT` (DESIGN §4).
+// It connects a DEALER to the server's broker, speaks api/wire.h, and renders
+// the units it is sent with TileRenderer::render_unit, exactly as
+// `skyfarm-worker render` does, so the farm's image is bit-identical.
+//
+// Threads
+//   I/O thread     the thread calling run(): the only one touching the
+//                  socket.  It sends READY, heartbeats every
+//                  heartbeat_interval whatever the renderers are doing (a
+//                  long unit never looks like a dead worker), queues UNITs
+//                  for the render threads, forwards their RESULT / FAILED,
+//                  and honours CANCEL.  Render threads wake it through a
+//                  pipe, so a result leaves as soon as it is ready.
+//   render threads `threads` of them (0 = all hardware threads); each
+//                  renders one unit at a time, single-threaded (render_unit
+//                  is sequential per unit; parallelism comes from units).
+// Slots (the credit announced in READY): default threads + 1, so every
+//   render thread is busy and one unit waits, which hides the round trip
+//   between a result leaving and the next unit arriving.  A worker started
+//   with --threads 1 (the server's embedded local workers) holds 2 units:
+//   one rendering while the next arrives.
+// Setups: api::make_render_setup is cached per job id (LRU of
+//   setup_cache_jobs = 4 jobs; an entry is rebuilt if the job's request text
+//   differs).  A request that does not parse, an out-of-range unit or any
+//   exception while rendering is answered with FAILED and the message.
+// CANCEL: a queued unit is dropped; one being rendered finishes but its
+//   result is not sent.
+// Server lost (nothing heard for heartbeat_liveness x interval, or a
+//   DISCONNECT): the socket is closed, the units of that session are
+//   abandoned (the server requeues them), and after a back-off
+//   (reconnect_initial doubling to reconnect_max, reset once the server
+//   answers) a new socket connects and sends READY again.  REREGISTER (the
+//   server forgot us) abandons the session's units and sends READY at once.
+//   A fatal DISCONNECT (wrong token, protocol version) ends run() with 1.
+// Drain (request_drain(), or *drain_flag set by a SIGTERM handler): the
+//   worker heartbeats "draining" so the server sends no more units, finishes
+//   the units it holds, sends their results, then DISCONNECT, and run()
+//   returns 0 (queued messages get drain_linger to leave).  Without a server
+//   connection it returns 0 at once.
+#pragma once
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace skyfarm {
+
+struct FarmWorkerOptions {
+  std::string endpoint = "tcp://127.0.0.1:5555";
+  int threads = 0;     // render threads; 0 = all hardware threads
+  int slots = 0;       // units held at once (credit); 0 = threads + 1
+  std::string token;   // shared secret sent in READY (empty: none)
+  std::string id;      // empty: hostname-pid-random
+  std::chrono::milliseconds heartbeat_interval{1000};
+  int heartbeat_liveness = 3;  // missed intervals before the server is declared lost
+  std::chrono::milliseconds reconnect_initial{1000};
+  std::chrono::milliseconds reconnect_max{32000};
+  std::chrono::milliseconds drain_linger{2000};
+  int setup_cache_jobs = 4;
+  // Checked every loop tick (<= 100 ms) in addition to request_drain(); a
+  // signal handler may set it (async-signal-safe).
+  const std::atomic<bool>* drain_flag = nullptr;
+  // Log lines; empty: standard error.
+  std::function<void(std::string_view)> log;
+};
+
+// Counters since construction (thread-safe reads).
+struct FarmWorkerStats {
+  std::uint64_t sessions = 0;         // READY sent (first connection, reconnects, REREGISTER)
+  std::uint64_t units_received = 0;
+  std::uint64_t results_sent = 0;
+  std::uint64_t failures_sent = 0;
+  std::uint64_t cancels_received = 0;
+  std::uint64_t results_dropped = 0;  // cancelled or abandoned units finished anyway
+  std::uint64_t malformed = 0;        // undecodable or unexpected messages from the server
+  std::uint64_t send_failures = 0;    // messages the socket would not queue
+};
+
+class FarmWorker {
+ public:
+  explicit FarmWorker(FarmWorkerOptions options = {});
+  ~FarmWorker();
+  FarmWorker(const FarmWorker&) = delete;
+  FarmWorker& operator=(const FarmWorker&) = delete;
+
+  // Serves until drained (0) or refused by the server (1).  Call once.
+  int run();
+  // Thread-safe and async-signal-safe.
+  void request_drain();
+  const std::string& id() const;
+  int threads() const;
+  int slots() const;
+  FarmWorkerStats stats() const;
+  // Tests: while paused the I/O loop neither reads nor heartbeats (a hung
+  // process, as under SIGSTOP); render threads go on.
+  void set_paused_for_testing(bool paused);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// hostname-pid-random, the default worker id.
+std::string default_worker_id();
+
+// `skyfarm-worker [--connect URL] [--threads N] [--slots N] [--token SECRET]
+// [--id NAME]`, each flag also read from SKYFARM_CONNECT, SKYFARM_THREADS,
+// SKYFARM_SLOTS, SKYFARM_TOKEN, SKYFARM_ID (a flag wins over its variable).
+// Installs the SIGTERM/SIGINT handlers (signals.h) and runs a FarmWorker;
+// returns its exit code (2 for bad arguments).
+int run_farm_worker_command(const std::vector<std::string>& args);
+extern const char* const kFarmWorkerUsage;
+
+}  // namespace skyfarm
