@@ -32,3 +32,27 @@ function(skyfarm_embed_data OUT_VAR)
     VERBATIM)
   set(${OUT_VAR} "${out}" PARENT_SCOPE)
 endfunction()
+
+# skyfarm_embed_files(OUT_VAR NAME NAMESPACE DIR FILE...): the same embedding
+# for other files: generated/NAME.cpp holds each FILE of DIR in NAMESPACE
+# (kEntries, kEntryCount; read them through a header of the user's own).
+# server/ embeds api/openapi.yaml this way.
+function(skyfarm_embed_files OUT_VAR NAME NAMESPACE DIR)
+  set(files ${ARGN})
+  set(inputs "")
+  foreach(f IN LISTS files)
+    list(APPEND inputs "${DIR}/${f}")
+  endforeach()
+  file(RELATIVE_PATH label "${PROJECT_SOURCE_DIR}" "${DIR}")
+  set(out "${PROJECT_BINARY_DIR}/generated/${NAME}.cpp")
+  string(REPLACE ";" "|" files_arg "${files}")
+  add_custom_command(
+    OUTPUT "${out}"
+    COMMAND ${CMAKE_COMMAND} -DDATA_DIR=${DIR} "-DFILES=${files_arg}" -DOUT=${out}
+            -DNAMESPACE=${NAMESPACE} -DSOURCE_LABEL=${label}/
+            -P ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    DEPENDS ${inputs} ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
+    COMMENT "Embedding ${NAME}"
+    VERBATIM)
+  set(${OUT_VAR} "${out}" PARENT_SCOPE)
+endfunction()

@@ -372,7 +372,9 @@ void JobService::Impl::write_images(Job& job, bool final) {
   layers.relative_error = out.error_layer;
   Image image(job.plan.width, job.plan.height, layers);
   job.merger->resolve(&image);
-  const std::string stem = final ? "image" : "preview";
+  // Previews are versioned by the units they hold, so a file and its ETag
+  // always agree; the previous one is removed (open readers keep its inode).
+  const std::string stem = final ? "image" : "preview-" + std::to_string(job.merger->merged_units());
   const Sun sun = Sun::from_spec(job.request.sun, job.request.location, job.request.time);
   api::set_render_metadata(&image, job.request, job.plan, sun,
                            std::min(job.plan.samples_per_pixel,
@@ -391,6 +393,11 @@ void JobService::Impl::write_images(Job& job, bool final) {
   } catch (const FileWriteError& e) {
     throw StorageError(e.what());
   }
+  if (job.preview_units >= 0 && job.preview_units != job.merger->merged_units()) {
+    std::error_code ec;
+    for (const char* ext : {".exr", ".png"})
+      fs::remove(job.dir / ("preview-" + std::to_string(job.preview_units) + ext), ec);
+  }
 }
 
 std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat format) {
@@ -407,7 +414,7 @@ std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat fo
     impl_->write_images(job, false);
     job.preview_units = job.merger->merged_units();
   }
-  return ImageFile{job.dir / (std::string("preview") + ext),
+  return ImageFile{job.dir / ("preview-" + std::to_string(job.preview_units) + ext),
                    "\"" + job.record.id + "-" + std::to_string(job.preview_units) + "\"", false};
 }
 

@@ -1,16 +1,107 @@
-// skyfarm-server: the HTTP API and ZeroMQ broker of the render farm.
-// The farm itself arrives with issue 4; this program exists so the layout and
-// the server's dependencies (cpp-httplib, cppzmq, SQLite) are built from the start.
+// skyfarm-server: the render farm's HTTP API and ZeroMQ broker, with local
+// workers by default (DESIGN §4).  See server_options.h for the flags.
+#include <httplib.h>
+#include <signal.h>
+
+#include <atomic>
+#include <chrono>
 #include <iostream>
-#include <string>
+#include <thread>
+
+#include "common/render/parallel.h"
+#include "server/broker.h"
+#include "server/http_api.h"
+#include "server/job_service.h"
+#include "server/local_workers.h"
+#include "server/server_options.h"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+bool is_loopback(const std::string& host) {
+  return host == "127.0.0.1" || host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
-  const std::string arg = argc > 1 ? argv[1] : "";
-  if (arg == "--version") {
-    std::cout << "skyfarm " << SKYFARM_VERSION << "\n";
+  using namespace skyfarm::server;
+  ServerOptions options;
+  if (const std::string err = parse_server_options({argv + 1, argv + argc}, &options); !err.empty()) {
+    std::cerr << "skyfarm-server: " << err << "\n" << kServerUsage;
+    return 2;
+  }
+  if (options.help) {
+    std::cout << kServerUsage;
     return 0;
   }
-  std::cerr << "skyfarm-server: the render farm is not implemented yet (issue 4).\n"
-               "Use `skyfarm-worker info REQUEST.json` to inspect a request's sky.\n";
-  return 2;
+  const std::size_t colon = options.listen.rfind(':');
+  const std::string host = options.listen.substr(0, colon);
+  int port = 0;
+  try {
+    port = std::stoi(options.listen.substr(colon + 1));
+  } catch (const std::exception&) {
+    std::cerr << "skyfarm-server: --listen: invalid port in '" << options.listen << "'\n";
+    return 2;
+  }
+  if (options.token.empty() && !is_loopback(host)) {
+    std::cerr << "skyfarm-server: refusing to listen on " << host
+              << " without --token (loopback only unless a token protects the API)\n";
+    return 2;
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigaction(SIGTERM, &sa, nullptr);
+  sigaction(SIGINT, &sa, nullptr);
+  signal(SIGPIPE, SIG_IGN);
+
+  try {
+    ServiceLimits limits;
+    limits.unit_timeout_s = options.unit_timeout_s;
+    JobService service(options.data_dir, limits);
+
+    BrokerOptions broker_options;
+    broker_options.endpoint = options.broker;
+    broker_options.token = options.token;
+    Broker broker(service, broker_options);
+    broker.start();
+
+    HttpOptions http_options;
+    if (!options.token.empty()) http_options.token = options.token;
+    HttpApi api(service, http_options);
+    httplib::Server http;
+    api.register_routes(http);
+    // Port 0: any free port (printed below), for tests and side-by-side servers.
+    const int bound_port = port == 0 ? http.bind_to_any_port(host.c_str()) : (http.bind_to_port(host.c_str(), port) ? port : -1);
+    if (bound_port <= 0) {
+      std::cerr << "skyfarm-server: cannot listen on " << options.listen << "\n";
+      broker.stop();
+      return 1;
+    }
+    std::thread http_thread([&] { http.listen_after_bind(); });
+
+    LocalWorkerOptions local;
+    local.worker_binary = options.worker_binary.empty() ? find_worker_binary(argv[0]) : options.worker_binary;
+    local.endpoint = broker.bound_endpoint();
+    local.count = options.local_workers < 0 ? skyfarm::resolve_thread_count(0) : options.local_workers;
+    local.token = options.token;
+    LocalWorkers workers(local);
+    workers.start();
+
+    std::cout << "skyfarm-server: HTTP on http://" << host << ":" << bound_port << ", broker on " << broker.bound_endpoint()
+              << ", " << local.count << " local worker(s), data in " << options.data_dir << std::endl;
+    while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+
+    std::cout << "skyfarm-server: shutting down" << std::endl;
+    workers.stop();
+    broker.stop();
+    http.stop();
+    http_thread.join();
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-server: " << e.what() << "\n";
+    return 1;
+  }
 }

@@ -1,0 +1,125 @@
+#include "server/http_metrics.h"
+
+#include <charconv>
+#include <cmath>
+#include <set>
+#include <string_view>
+
+namespace skyfarm::server {
+namespace {
+
+struct KnownMetric {
+  std::string_view key;   // in HttpBackend::metrics()
+  std::string_view name;  // exported
+  std::string_view type;
+  std::string_view help;
+};
+
+constexpr KnownMetric kKnown[] = {
+    {"queue_units", "skyfarm_queue_units", "gauge", "Work units waiting to be dispatched."},
+    {"units_in_flight", "skyfarm_units_in_flight", "gauge", "Work units dispatched to workers and not returned yet."},
+    {"workers", "skyfarm_workers", "gauge", "Connected workers."},
+    {"samples_per_second", "skyfarm_samples_per_second", "gauge", "Samples merged per second, recent average."},
+    {"unit_failures", "skyfarm_unit_failures_total", "counter", "Work units reported failed by workers."},
+    {"requeues", "skyfarm_unit_requeues_total", "counter", "Work units requeued (lost worker, timeout, failure)."},
+};
+constexpr std::string_view kJobsPrefix = "jobs_";
+
+std::string format_value(const nlohmann::json& v) {
+  if (v.is_number_unsigned()) return std::to_string(v.get<std::uint64_t>());
+  if (v.is_number_integer()) return std::to_string(v.get<std::int64_t>());
+  const double x = v.get<double>();
+  if (std::isnan(x)) return "NaN";
+  if (std::isinf(x)) return x > 0 ? "+Inf" : "-Inf";
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, x);
+  return std::string(buf, r.ptr);
+}
+
+void header(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
+  out.append("# HELP ").append(name).append(" ").append(help).append("\n");
+  out.append("# TYPE ").append(name).append(" ").append(type).append("\n");
+}
+
+void sample(std::string& out, std::string_view name, std::string_view labels, const std::string& value) {
+  out.append(name);
+  if (!labels.empty()) out.append("{").append(labels).append("}");
+  out.append(" ").append(value).append("\n");
+}
+
+// A metric or label-value name made of [a-zA-Z0-9_] only.
+std::string sanitized(std::string_view key) {
+  std::string s(key);
+  for (char& c : s)
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_')) c = '_';
+  return s;
+}
+
+void append_known(std::string& out, const nlohmann::json& backend) {
+  for (const auto& m : kKnown) {
+    const auto it = backend.find(std::string(m.key));
+    if (it == backend.end() || !it->is_number()) continue;
+    header(out, m.name, m.type, m.help);
+    sample(out, m.name, "", format_value(*it));
+  }
+}
+
+void append_jobs(std::string& out, const nlohmann::json& backend) {
+  bool any = false;
+  for (auto it = backend.begin(); it != backend.end(); ++it) {
+    if (!it.key().starts_with(kJobsPrefix) || !it->is_number()) continue;
+    if (!any) header(out, "skyfarm_jobs", "gauge", "Jobs by state.");
+    any = true;
+    const std::string state = sanitized(std::string_view(it.key()).substr(kJobsPrefix.size()));
+    sample(out, "skyfarm_jobs", "state=\"" + state + "\"", format_value(*it));
+  }
+}
+
+void append_others(std::string& out, const nlohmann::json& backend) {
+  std::set<std::string> taken = {"skyfarm_jobs", "skyfarm_http_responses_total", "skyfarm_http_requests_total",
+                                 "skyfarm_http_event_streams"};
+  for (const auto& m : kKnown) {
+    taken.insert(std::string(m.name));
+    taken.insert("skyfarm_" + std::string(m.key));
+  }
+  for (auto it = backend.begin(); it != backend.end(); ++it) {
+    if (it.key().empty() || it.key().starts_with(kJobsPrefix) || !it->is_number()) continue;
+    const std::string name = "skyfarm_" + sanitized(it.key());
+    if (!taken.insert(name).second) continue;
+    header(out, name, "gauge", "Job service figure \"" + sanitized(it.key()) + "\".");
+    sample(out, name, "", format_value(*it));
+  }
+}
+
+}  // namespace
+
+void ResponseCounter::count(int status) {
+  if (status >= 100 && status < static_cast<int>(counts_.size()))
+    counts_[static_cast<std::size_t>(status)].fetch_add(1, std::memory_order_relaxed);
+}
+
+std::vector<std::pair<int, std::uint64_t>> ResponseCounter::snapshot() const {
+  std::vector<std::pair<int, std::uint64_t>> out;
+  for (std::size_t code = 100; code < counts_.size(); ++code)
+    if (const auto n = counts_[code].load(std::memory_order_relaxed); n > 0)
+      out.emplace_back(static_cast<int>(code), n);
+  return out;
+}
+
+std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter& responses,
+                            int open_event_streams) {
+  std::string out;
+  if (backend.is_object()) {
+    append_known(out, backend);
+    append_jobs(out, backend);
+    append_others(out, backend);
+  }
+  header(out, "skyfarm_http_requests_total", "counter", "HTTP responses sent, by status code.");
+  for (const auto& [code, n] : responses.snapshot())
+    sample(out, "skyfarm_http_requests_total", "code=\"" + std::to_string(code) + "\"", std::to_string(n));
+  header(out, "skyfarm_http_event_streams", "gauge", "Open Server-Sent Events streams.");
+  sample(out, "skyfarm_http_event_streams", "", std::to_string(open_event_streams));
+  return out;
+}
+
+}  // namespace skyfarm::server

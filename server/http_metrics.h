@@ -1,0 +1,37 @@
+// GET /metrics: the Prometheus text exposition format (version 0.0.4) of the
+// backend's numbers plus what the HTTP layer counts itself (responses by
+// status code, open event streams).  Every name is prefixed skyfarm_.
+#pragma once
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace skyfarm::server {
+
+inline constexpr const char* kPrometheusContentType = "text/plain; version=0.0.4; charset=utf-8";
+
+// Responses by status code (100-599), counted lock-free.
+class ResponseCounter {
+ public:
+  void count(int status);
+  // (code, count) for every code seen, in code order.
+  std::vector<std::pair<int, std::uint64_t>> snapshot() const;
+
+ private:
+  std::array<std::atomic<std::uint64_t>, 600> counts_{};
+};
+
+// The exposition text.  `backend` is HttpBackend::metrics(): known keys get
+// their documented names (queue_units -> skyfarm_queue_units,
+// unit_failures -> skyfarm_unit_failures_total, jobs_<state> ->
+// skyfarm_jobs{state="<state>"}, ...); other numeric keys are exported as
+// gauges skyfarm_<key>; non-numeric values are skipped.
+std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter& responses,
+                            int open_event_streams);
+
+}  // namespace skyfarm::server

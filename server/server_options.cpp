@@ -1,0 +1,81 @@
+#include "server/server_options.h"
+
+#include <cstdlib>
+#include <stdexcept>
+
+namespace skyfarm::server {
+
+const char* const kServerUsage =
+    "usage: skyfarm-server [--listen 127.0.0.1:8080] [--broker tcp://127.0.0.1:5555]\n"
+    "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
+    "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
+    "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
+    "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT).\n"
+    "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
+
+namespace {
+
+struct Flag {
+  const char* name;
+  const char* env;
+};
+constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
+                           {"--broker", "SKYFARM_BROKER"},
+                           {"--local-workers", "SKYFARM_LOCAL_WORKERS"},
+                           {"--data-dir", "SKYFARM_DATA_DIR"},
+                           {"--token", "SKYFARM_TOKEN"},
+                           {"--worker-binary", "SKYFARM_WORKER_BINARY"},
+                           {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"}};
+
+std::string set(const std::string& flag, const std::string& value, ServerOptions* o) {
+  try {
+    if (flag == "--listen") {
+      if (value.rfind(':') == std::string::npos) return "--listen: expected HOST:PORT, got '" + value + "'";
+      o->listen = value;
+    } else if (flag == "--broker") {
+      o->broker = value;
+    } else if (flag == "--local-workers") {
+      std::size_t used = 0;
+      const int n = std::stoi(value, &used);
+      if (used != value.size() || n < 0 || n > 1024) throw std::invalid_argument("range");
+      o->local_workers = n;
+    } else if (flag == "--data-dir") {
+      o->data_dir = value;
+    } else if (flag == "--token") {
+      o->token = value;
+    } else if (flag == "--worker-binary") {
+      o->worker_binary = value;
+    } else if (flag == "--unit-timeout") {
+      std::size_t used = 0;
+      const double s = std::stod(value, &used);
+      if (used != value.size() || !(s > 0.0)) throw std::invalid_argument("range");
+      o->unit_timeout_s = s;
+    }
+  } catch (const std::exception&) {
+    return flag + ": invalid value '" + value + "'";
+  }
+  return "";
+}
+
+}  // namespace
+
+std::string parse_server_options(const std::vector<std::string>& args, ServerOptions* out) {
+  for (const Flag& f : kFlags)
+    if (const char* v = std::getenv(f.env); v && *v)
+      if (std::string e = set(f.name, v, out); !e.empty()) return e + " (from " + f.env + ")";
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    if (a == "--help" || a == "-h") {
+      out->help = true;
+      continue;
+    }
+    bool known = false;
+    for (const Flag& f : kFlags) known = known || a == f.name;
+    if (!known) return "unknown option '" + a + "'";
+    if (i + 1 >= args.size()) return a + ": a value is required";
+    if (std::string e = set(a, args[++i], out); !e.empty()) return e;
+  }
+  return "";
+}
+
+}  // namespace skyfarm::server

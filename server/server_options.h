@@ -1,0 +1,33 @@
+// skyfarm-server's command line (DESIGN §4.1 — the names are a contract):
+//   --listen 127.0.0.1:8080     HTTP address           (SKYFARM_LISTEN)
+//   --broker tcp://127.0.0.1:5555  ZeroMQ ROUTER endpoint (SKYFARM_BROKER)
+//   --local-workers N           local worker processes, default: cores; 0 = none (SKYFARM_LOCAL_WORKERS)
+//   --data-dir ./skyfarm-data   jobs, tiles and images   (SKYFARM_DATA_DIR)
+//   --token SECRET              bearer token for /v1 and shared secret for workers (SKYFARM_TOKEN)
+//   --worker-binary PATH        skyfarm-worker to start  (SKYFARM_WORKER_BINARY)
+//   --unit-timeout S            requeue a unit after S seconds without a result (SKYFARM_UNIT_TIMEOUT)
+// A flag beats its environment variable, which beats the default.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace skyfarm::server {
+
+struct ServerOptions {
+  std::string listen = "127.0.0.1:8080";
+  std::string broker = "tcp://127.0.0.1:5555";
+  int local_workers = -1;  // -1: one per core
+  std::string data_dir = "./skyfarm-data";
+  std::string token;
+  std::string worker_binary;
+  double unit_timeout_s = 120.0;
+  bool help = false;
+};
+
+// Parses argv (without the program name) and the environment; returns an
+// error message naming the flag, or "".
+std::string parse_server_options(const std::vector<std::string>& args, ServerOptions* out);
+extern const char* const kServerUsage;
+
+}  // namespace skyfarm::server
