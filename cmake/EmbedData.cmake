@@ -16,27 +16,10 @@ set(SKYFARM_DATA_FILES
 )
 
 function(skyfarm_embed_data OUT_VAR)
-  set(inputs "")
-  foreach(f IN LISTS SKYFARM_DATA_FILES)
-    list(APPEND inputs "${PROJECT_SOURCE_DIR}/data/${f}")
-  endforeach()
-  set(out "${PROJECT_BINARY_DIR}/generated/embedded_data.cpp")
-  string(REPLACE ";" "|" files_arg "${SKYFARM_DATA_FILES}")
-  add_custom_command(
-    OUTPUT "${out}"
-    COMMAND ${CMAKE_COMMAND} -DDATA_DIR=${PROJECT_SOURCE_DIR}/data
-            "-DFILES=${files_arg}" -DOUT=${out}
-            -P ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
-    DEPENDS ${inputs} ${PROJECT_SOURCE_DIR}/cmake/embed_files.cmake
-    COMMENT "Embedding data tables"
-    VERBATIM)
+  skyfarm_embed_files(out embedded_data skyfarm::embedded ${PROJECT_SOURCE_DIR}/data ${SKYFARM_DATA_FILES})
   set(${OUT_VAR} "${out}" PARENT_SCOPE)
 endfunction()
 
-# skyfarm_embed_files(OUT_VAR NAME NAMESPACE DIR FILE...): the same embedding
-# for other files: generated/NAME.cpp holds each FILE of DIR in NAMESPACE
-# (kEntries, kEntryCount; read them through a header of the user's own).
-# server/ embeds api/openapi.yaml this way.
 function(skyfarm_embed_files OUT_VAR NAME NAMESPACE DIR)
   set(files ${ARGN})
   set(inputs "")

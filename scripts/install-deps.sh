@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config curl bc
   libopenexr-dev libimath-dev libglm-dev nlohmann-json3-dev libpng-dev
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev

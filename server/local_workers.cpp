@@ -62,6 +62,7 @@ void LocalWorkers::supervise() {
       if (pids_[i] > 0) {
         int status = 0;
         if (::waitpid(pids_[i], &status, WNOHANG) == pids_[i]) {
+          if (stopping_) break;
           std::fprintf(stderr, "skyfarm-server: local worker %d (pid %d) exited; restarting in %lld s\n",
                        static_cast<int>(i), static_cast<int>(pids_[i]), static_cast<long long>(backoff[i].count()));
           pids_[i] = 0;

@@ -1,25 +1,31 @@
 #include "worker/demo_requests.h"
 
+#include <cstddef>
+#include <string_view>
+
+// Generated as embedded_demos.cpp from api/examples/demo_*.json (worker/CMakeLists.txt).
+namespace skyfarm::embedded_demos {
+struct Entry { const char* name; const char* data; std::size_t size; };
+extern const Entry kEntries[];
+extern const std::size_t kEntryCount;
+}  // namespace skyfarm::embedded_demos
+
 namespace skyfarm {
 
+// api/examples/demo_<name>.json, embedded: the files the README's run command
+// also posts to the farm, so both render the same requests.
 const std::vector<DemoRequest>& demo_requests() {
-  static const std::vector<DemoRequest> demos = {
-      {"sunset_equirect", R"({
-        "location": {"latitude_deg": 42.44, "longitude_deg": -76.48, "altitude_m": 250},
-        "time": "2013-05-27T20:15:00-04:00",
-        "camera": {"projection": "equirectangular", "width": 512, "height": 256, "yaw_deg": 300},
-        "spectral": {"batches": 2},
-        "quality": {"samples_per_pixel": 32},
-        "output": {"half": false}})"},
-      {"noon_fisheye", R"({
-        "location": {"latitude_deg": 48.8566, "longitude_deg": 2.3522, "altitude_m": 35},
-        "time": "2021-06-21T13:50:00+02:00",
-        "camera": {"projection": "fisheye", "width": 256, "height": 256, "yaw_deg": 180, "pitch_deg": 90,
-                   "fov_deg": 180},
-        "spectral": {"batches": 2},
-        "quality": {"samples_per_pixel": 32},
-        "output": {"half": false}})"},
-  };
+  static const std::vector<DemoRequest> demos = [] {
+    std::vector<DemoRequest> out;
+    for (std::size_t i = 0; i < embedded_demos::kEntryCount; ++i) {
+      const auto& e = embedded_demos::kEntries[i];
+      std::string_view name(e.name);
+      name.remove_prefix(std::string_view("demo_").size());
+      name.remove_suffix(std::string_view(".json").size());
+      out.push_back({std::string(name), std::string(e.data, e.size)});
+    }
+    return out;
+  }();
   return demos;
 }
 
