@@ -60,6 +60,8 @@ int main(int argc, char** argv) {
   try {
     ServiceLimits limits;
     limits.unit_timeout_s = options.unit_timeout_s;
+    limits.max_active_jobs = options.max_active_jobs;
+    limits.max_queue_units = options.max_queue_units;
     JobService service(options.data_dir, limits);
 
     BrokerOptions broker_options;
@@ -70,6 +72,7 @@ int main(int argc, char** argv) {
 
     HttpOptions http_options;
     if (!options.token.empty()) http_options.token = options.token;
+    http_options.max_body_bytes = static_cast<std::size_t>(options.max_body_bytes);
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);

@@ -9,8 +9,10 @@ const char* const kServerUsage =
     "usage: skyfarm-server [--listen 127.0.0.1:8080] [--broker tcp://127.0.0.1:5555]\n"
     "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
+    "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
-    "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT).\n"
+    "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
+    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES).\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
 
 namespace {
@@ -25,7 +27,18 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--data-dir", "SKYFARM_DATA_DIR"},
                            {"--token", "SKYFARM_TOKEN"},
                            {"--worker-binary", "SKYFARM_WORKER_BINARY"},
-                           {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"}};
+                           {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"},
+                           {"--max-active-jobs", "SKYFARM_MAX_ACTIVE_JOBS"},
+                           {"--max-queue-units", "SKYFARM_MAX_QUEUE_UNITS"},
+                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"}};
+
+// A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
+long long whole_number(const std::string& value, long long lo, long long hi) {
+  std::size_t used = 0;
+  const long long n = std::stoll(value, &used);
+  if (used != value.size() || n < lo || n > hi) throw std::invalid_argument("range");
+  return n;
+}
 
 std::string set(const std::string& flag, const std::string& value, ServerOptions* o) {
   try {
@@ -35,10 +48,13 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
     } else if (flag == "--broker") {
       o->broker = value;
     } else if (flag == "--local-workers") {
-      std::size_t used = 0;
-      const int n = std::stoi(value, &used);
-      if (used != value.size() || n < 0 || n > 1024) throw std::invalid_argument("range");
-      o->local_workers = n;
+      o->local_workers = static_cast<int>(whole_number(value, 0, 1024));
+    } else if (flag == "--max-active-jobs") {
+      o->max_active_jobs = static_cast<int>(whole_number(value, 1, 1000000));
+    } else if (flag == "--max-queue-units") {
+      o->max_queue_units = static_cast<int>(whole_number(value, 1, 1000000000));
+    } else if (flag == "--max-body-bytes") {
+      o->max_body_bytes = whole_number(value, 1024, 1LL << 30);
     } else if (flag == "--data-dir") {
       o->data_dir = value;
     } else if (flag == "--token") {

@@ -6,6 +6,9 @@
 //   --token SECRET              bearer token for /v1 and shared secret for workers (SKYFARM_TOKEN)
 //   --worker-binary PATH        skyfarm-worker to start  (SKYFARM_WORKER_BINARY)
 //   --unit-timeout S            requeue a unit after S seconds without a result (SKYFARM_UNIT_TIMEOUT)
+//   --max-active-jobs N         queued + running jobs before 429 (SKYFARM_MAX_ACTIVE_JOBS)
+//   --max-queue-units N         units waiting over all jobs before 429 (SKYFARM_MAX_QUEUE_UNITS)
+//   --max-body-bytes N          request body limit, 413 beyond (SKYFARM_MAX_BODY_BYTES)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -22,6 +25,9 @@ struct ServerOptions {
   std::string token;
   std::string worker_binary;
   double unit_timeout_s = 120.0;
+  int max_active_jobs = 64;
+  int max_queue_units = 4000000;
+  long long max_body_bytes = 1 << 20;
   bool help = false;
 };
 

@@ -1,0 +1,46 @@
+// skyfarm-server's flags (DESIGN §4.1, a contract) and their environment variables.
+#include "server/server_options.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+
+namespace skyfarm::server {
+namespace {
+
+TEST(ServerOptions, DefaultsMatchTheDesign) {
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({}, &o), "");
+  EXPECT_EQ(o.listen, "127.0.0.1:8080");
+  EXPECT_EQ(o.broker, "tcp://127.0.0.1:5555");
+  EXPECT_EQ(o.local_workers, -1);  // one per core
+  EXPECT_EQ(o.data_dir, "./skyfarm-data");
+  EXPECT_TRUE(o.token.empty());
+}
+
+TEST(ServerOptions, FlagsBeatEnvironmentWhichBeatsDefaults) {
+  ::setenv("SKYFARM_LOCAL_WORKERS", "3", 1);
+  ::setenv("SKYFARM_DATA_DIR", "/tmp/from-env", 1);
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({"--local-workers", "0", "--token", "s3cret", "--listen", "0.0.0.0:9000"}, &o), "");
+  ::unsetenv("SKYFARM_LOCAL_WORKERS");
+  ::unsetenv("SKYFARM_DATA_DIR");
+  EXPECT_EQ(o.local_workers, 0);
+  EXPECT_EQ(o.data_dir, "/tmp/from-env");
+  EXPECT_EQ(o.token, "s3cret");
+  EXPECT_EQ(o.listen, "0.0.0.0:9000");
+}
+
+TEST(ServerOptions, BadValuesNameTheFlag) {
+  ServerOptions o;
+  EXPECT_EQ(parse_server_options({"--local-workers", "-1"}, &o), "--local-workers: invalid value '-1'");
+  EXPECT_EQ(parse_server_options({"--listen", "nohost"}, &o), "--listen: expected HOST:PORT, got 'nohost'");
+  EXPECT_EQ(parse_server_options({"--frobnicate"}, &o), "unknown option '--frobnicate'");
+  EXPECT_EQ(parse_server_options({"--data-dir"}, &o), "--data-dir: a value is required");
+  ::setenv("SKYFARM_UNIT_TIMEOUT", "soon", 1);
+  EXPECT_EQ(parse_server_options({}, &o), "--unit-timeout: invalid value 'soon' (from SKYFARM_UNIT_TIMEOUT)");
+  ::unsetenv("SKYFARM_UNIT_TIMEOUT");
+}
+
+}  // namespace
+}  // namespace skyfarm::server
