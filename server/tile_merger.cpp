@@ -23,11 +23,13 @@ FilmTile empty_tile(const RenderPlan& plan, int t) {
 
 }  // namespace
 
-TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir) : plan_(plan), dir_(std::move(dir)) {
+TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes)
+    : plan_(plan), dir_(std::move(dir)), budget_(memory_budget_bytes) {
   std::error_code ec;
   std::filesystem::create_directories(dir_, ec);
   if (ec) throw StorageError("cannot create " + dir_.string() + ": " + ec.message());
-  for (int t = 0; t < plan_.tile_count(); ++t) tiles_.push_back(empty_tile(plan_, t));
+  cache_.resize(static_cast<std::size_t>(plan_.tile_count()));
+  lru_pos_.resize(static_cast<std::size_t>(plan_.tile_count()));
   next_index_.assign(static_cast<std::size_t>(plan_.tile_count()), 0);
   waiting_.resize(static_cast<std::size_t>(plan_.tile_count()));
   load();
@@ -44,7 +46,7 @@ bool TileMerger::received(const WorkUnit& u) const {
 bool TileMerger::add(const WorkUnit& u, FilmTile film) {
   const auto t = static_cast<std::size_t>(u.tile);
   if (received(u)) return false;
-  const FilmTile& target = tiles_[t];
+  FilmTile& target = tile(u.tile);
   if (film.x0() != target.x0() || film.y0() != target.y0() || film.width() != target.width() ||
       film.height() != target.height() || film.batches() != target.batches())
     throw FilmTileDecodeError("result tile does not match tile " + std::to_string(u.tile) + " of the plan");
@@ -52,13 +54,13 @@ bool TileMerger::add(const WorkUnit& u, FilmTile film) {
   // Merge every waiting result that is next in canonical order.
   bool advanced = false;
   for (auto it = waiting_[t].find(next_index_[t]); it != waiting_[t].end(); it = waiting_[t].find(next_index_[t])) {
-    tiles_[t].merge(it->second);
+    target.merge(it->second);
     waiting_[t].erase(it);
     ++next_index_[t];
     ++merged_units_;
     advanced = true;
   }
-  if (advanced) persist(u.tile);
+  if (advanced) persist(u.tile, target);
   return true;
 }
 
@@ -69,22 +71,24 @@ int TileMerger::complete_passes() const {
 }
 
 void TileMerger::resolve(Image* image) const {
-  for (const auto& tile : tiles_) image->resolve(tile);
+  for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(tile(t));
 }
 
 std::optional<double> TileMerger::estimated_relative_rms() const {
   ErrorSums sums;
-  for (const auto& tile : tiles_) sums.add(error_sums(tile));
+  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(error_sums(tile(t)));
   return sums.relative_rms();
 }
 
 // File: magic, version, units merged (little-endian uint32 each), then the
 // FilmTile's own serialisation (which carries a CRC).
-void TileMerger::persist(int t) const {
-  const auto bytes = tiles_[static_cast<std::size_t>(t)].serialize();
+std::filesystem::path TileMerger::tile_path(int t) const { return dir_ / ("tile_" + std::to_string(t) + ".bin"); }
+
+void TileMerger::persist(int t, const FilmTile& film) const {
+  const auto bytes = film.serialize();
   const std::uint32_t header[2] = {kVersion, static_cast<std::uint32_t>(next_index_[static_cast<std::size_t>(t)])};
   try {
-    AtomicFile file(dir_ / ("tile_" + std::to_string(t) + ".bin"));
+    AtomicFile file(tile_path(t));
     file.write(kMagic, sizeof kMagic);
     file.write(header, sizeof header);
     file.write(bytes.data(), bytes.size());
@@ -94,30 +98,67 @@ void TileMerger::persist(int t) const {
   }
 }
 
+// The tile file, validated against the plan; nullopt when absent or damaged
+// (a damaged tile is rendered again from scratch).
+std::optional<FilmTile> TileMerger::read_tile(int t, int* units) const {
+  std::ifstream in(tile_path(t), std::ios::binary);
+  if (!in) return std::nullopt;
+  const std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::uint32_t header[2] = {0, 0};
+  if (data.size() < sizeof kMagic + sizeof header || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0)
+    return std::nullopt;
+  std::memcpy(header, data.data() + sizeof kMagic, sizeof header);
+  if (header[0] != kVersion || header[1] > static_cast<std::uint32_t>(plan_.batches * plan_.passes)) return std::nullopt;
+  try {
+    const std::size_t off = sizeof kMagic + sizeof header;
+    FilmTile tile = FilmTile::deserialize(reinterpret_cast<const std::uint8_t*>(data.data()) + off, data.size() - off);
+    const FilmTile expect = empty_tile(plan_, t);
+    if (tile.x0() != expect.x0() || tile.y0() != expect.y0() || tile.width() != expect.width() ||
+        tile.height() != expect.height() || tile.batches() != expect.batches())
+      return std::nullopt;
+    *units = static_cast<int>(header[1]);
+    return tile;
+  } catch (const FilmTileDecodeError&) {
+    return std::nullopt;
+  }
+}
+
+// At start: how far every tile got (files are validated now, read again
+// when their tile is next needed).
 void TileMerger::load() {
   for (int t = 0; t < plan_.tile_count(); ++t) {
-    std::ifstream in(dir_ / ("tile_" + std::to_string(t) + ".bin"), std::ios::binary);
-    if (!in) continue;
-    const std::vector<char> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    std::uint32_t header[2] = {0, 0};
-    if (data.size() < sizeof kMagic + sizeof header || std::memcmp(data.data(), kMagic, sizeof kMagic) != 0) continue;
-    std::memcpy(header, data.data() + sizeof kMagic, sizeof header);
-    if (header[0] != kVersion || header[1] > static_cast<std::uint32_t>(plan_.batches * plan_.passes)) continue;
-    try {
-      const std::size_t off = sizeof kMagic + sizeof header;
-      FilmTile tile = FilmTile::deserialize(reinterpret_cast<const std::uint8_t*>(data.data()) + off,
-                                            data.size() - off);
-      const FilmTile& expect = tiles_[static_cast<std::size_t>(t)];
-      if (tile.x0() != expect.x0() || tile.y0() != expect.y0() || tile.width() != expect.width() ||
-          tile.height() != expect.height() || tile.batches() != expect.batches())
-        continue;
-      tiles_[static_cast<std::size_t>(t)] = std::move(tile);
-      next_index_[static_cast<std::size_t>(t)] = static_cast<int>(header[1]);
-      merged_units_ += static_cast<int>(header[1]);
-    } catch (const FilmTileDecodeError&) {
-      // A damaged tile is rendered again from scratch.
-    }
+    int units = 0;
+    if (!read_tile(t, &units)) continue;
+    next_index_[static_cast<std::size_t>(t)] = units;
+    merged_units_ += units;
   }
+}
+
+FilmTile& TileMerger::tile(int t) const {
+  auto& slot = cache_[static_cast<std::size_t>(t)];
+  if (slot) {
+    lru_.splice(lru_.begin(), lru_, lru_pos_[static_cast<std::size_t>(t)]);
+    return *slot;
+  }
+  int units = 0;
+  std::optional<FilmTile> loaded;
+  if (next_index_[static_cast<std::size_t>(t)] > 0) loaded = read_tile(t, &units);
+  slot = std::make_unique<FilmTile>(loaded ? std::move(*loaded) : empty_tile(plan_, t));
+  const std::size_t bytes = static_cast<std::size_t>(slot->width()) * static_cast<std::size_t>(slot->height()) *
+                            static_cast<std::size_t>(plan_.batches) * 6 * sizeof(double);
+  cached_bytes_ += bytes;
+  lru_.push_front(t);
+  lru_pos_[static_cast<std::size_t>(t)] = lru_.begin();
+  // Evict the least recently used tiles (already on disk) beyond the budget.
+  while (cached_bytes_ > budget_ && lru_.size() > 1) {
+    const int victim = lru_.back();
+    lru_.pop_back();
+    auto& v = cache_[static_cast<std::size_t>(victim)];
+    cached_bytes_ -= static_cast<std::size_t>(v->width()) * static_cast<std::size_t>(v->height()) *
+                     static_cast<std::size_t>(plan_.batches) * 6 * sizeof(double);
+    v.reset();
+  }
+  return *slot;
 }
 
 }  // namespace skyfarm::server

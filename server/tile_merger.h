@@ -9,9 +9,16 @@
 // each advance the tile (its sums and how many units it holds) is written
 // atomically to <dir>/tile_<t>.bin; a restarted server reloads these files
 // and resumes after the last merged unit of each tile.
+//
+// Memory: only the most recently used tiles stay in memory, up to
+// `memory_budget_bytes` (the others are on disk already and are read back
+// when their next unit arrives), so a 4096x2048 job does not need its whole
+// film in the server's memory.
 #pragma once
 #include <filesystem>
+#include <list>
 #include <map>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -25,7 +32,7 @@ class TileMerger {
  public:
   // Creates `dir` if needed and reloads the tiles found there.  Throws
   // StorageError when the directory cannot be created.
-  TileMerger(const RenderPlan& plan, std::filesystem::path dir);
+  TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes = 64u << 20);
 
   // A unit's result.  Returns false (and ignores it) when that unit is already
   // merged or waiting.  Throws FilmTileDecodeError on a tile of the wrong
@@ -50,12 +57,20 @@ class TileMerger {
 
  private:
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }
-  void persist(int tile) const;
+  std::filesystem::path tile_path(int tile) const;
+  void persist(int tile, const FilmTile& film) const;
   void load();
+  // The tile's sums, from memory or disk; keeps the cache within its budget.
+  FilmTile& tile(int t) const;
+  std::optional<FilmTile> read_tile(int t, int* units) const;
 
   RenderPlan plan_;
   std::filesystem::path dir_;
-  std::vector<FilmTile> tiles_;
+  std::size_t budget_;
+  mutable std::vector<std::unique_ptr<FilmTile>> cache_;  // nullptr: on disk (or empty)
+  mutable std::list<int> lru_;                            // most recent first
+  mutable std::vector<std::list<int>::iterator> lru_pos_; // each cached tile's place in lru_
+  mutable std::size_t cached_bytes_ = 0;
   std::vector<int> next_index_;                   // per tile: units merged
   std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
   int merged_units_ = 0;
