@@ -73,9 +73,10 @@ void AtomicFile::seek(std::uint64_t pos) {
   pos_ = pos;
 }
 
-void AtomicFile::commit() {
+void AtomicFile::commit(Durability durability) {
   if (fd_ < 0) throw FileWriteError("cannot write '" + path_.string() + "': the file is already closed");
-  if (::fsync(fd_) != 0) {
+  const bool sync = durability == Durability::kSynced;
+  if (sync && ::fsync(fd_) != 0) {
     const int err = errno;  // EINVAL/EROFS: a file system without fsync (not an error)
     if (err != EINVAL && err != EROFS) fail("fsync of '" + tmp_.string() + "' failed", err);
   }
@@ -90,6 +91,7 @@ void AtomicFile::commit() {
     fail("cannot rename '" + tmp_.string() + "' onto it", err);
   }
   committed_ = true;
+  if (!sync) return;
   // Make the rename itself durable (best effort: some file systems refuse).
   std::filesystem::path dir = path_.parent_path();
   if (dir.empty()) dir = ".";

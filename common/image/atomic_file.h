@@ -47,7 +47,11 @@ class AtomicFile {
 
   // fsync, close, rename onto path(); throws FileWriteError on failure (the
   // temporary file is then removed).
-  void commit();
+  // kRenamed skips both fsyncs: still atomic for readers, but after a power
+  // failure the file may be the old one or empty; for data that can be
+  // recomputed and is validated when read (the farm's merged tiles).
+  enum class Durability { kSynced, kRenamed };
+  void commit(Durability durability = Durability::kSynced);
 
   // Writes a whole buffer to `path` atomically.
   static void write_file(const std::filesystem::path& path, const void* data, std::size_t n);
