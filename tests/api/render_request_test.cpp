@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/test_files.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -20,14 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kExamples = fs::path(SKYFARM_SOURCE_DIR) / "api" / "examples";
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using skyfarm::testing::kExamples;
+using skyfarm::testing::read_text;
 
 // The examples of one kind: probe*.json are probes, the others render requests.
 std::vector<fs::path> json_files(const fs::path& dir, bool probes) {

@@ -8,6 +8,8 @@
 
 #include <arpa/inet.h>
 #include <gtest/gtest.h>
+
+#include "tests/support/test_files.h"
 #include <httplib.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
@@ -37,14 +39,8 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using testing::FakeBackend;
 
-const fs::path kExamples = fs::path(SKYFARM_SOURCE_DIR) / "api" / "examples";
-
-std::string read_text(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using skyfarm::testing::kExamples;
+using skyfarm::testing::read_text;
 
 std::string good_request() { return read_text(kExamples / "noon_fisheye.json"); }
 
