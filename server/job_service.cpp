@@ -203,6 +203,8 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
   job->dir = data_dir / "jobs" / record.id;
   job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
   job->passes_reported = job->merger->complete_passes();
+  if (request.quality.target_relative_error || request.quality.time_limit_s)
+    job->merger->set_pass_limit(job->merger->complete_passes() + 1);
   job->record = std::move(record);
   job->request = std::move(request);
   if (!job->record.idempotency_key.empty()) idempotency[job->record.idempotency_key] = job->record.id;
@@ -285,7 +287,7 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
 
 nlohmann::json JobService::Impl::status_of(const Job& job) const {
   const int merged = job.merger->merged_units(), total = job.merger->total_units();
-  const double fraction = total > 0 ? static_cast<double>(merged) / total : 1.0;
+  const double fraction = job.record.state == "done" ? 1.0 : total > 0 ? static_cast<double>(merged) / total : 1.0;
   const double elapsed = job.elapsed_s();
   const int passes = job.merger->complete_passes();
   const int spp = std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass);
@@ -564,20 +566,52 @@ void JobService::Impl::fail_job(Job& job, const std::string& message) {
 }
 
 // When every unit is merged: the final image files, then "done".
+// True when the request can stop before its last sample (DESIGN §6 quality modes).
+bool stops_early(const Job& job) {
+  return job.request.quality.target_relative_error.has_value() || job.request.quality.time_limit_s.has_value();
+}
+
+// After merges: advance the pass gate (early-stopping jobs), record the error
+// of every newly completed pass, and finish the job when its samples are all
+// merged, its target error is reached, or its time limit has passed (checked
+// at pass boundaries: the pass in progress completes, so the image is always
+// a whole number of passes and equals a local render of that many passes).
 void JobService::Impl::finish_if_complete(Job& job) {
-  const int passes = job.merger->complete_passes();
-  if (passes > job.passes_reported) {
-    job.passes_reported = passes;
-    nlohmann::json e = nullptr;
-    if (const auto rms = job.merger->estimated_relative_rms()) e = *rms;
-    job.history.push_back({{"elapsed_s", job.elapsed_s()},
-                           {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
-                           {"estimated_relative_rms", e}});
+  if (!job.active()) return;
+  std::string stop;
+  while (stop.empty()) {
+    const int passes = job.merger->complete_passes();
+    if (passes > job.passes_reported) {
+      job.passes_reported = passes;
+      const auto rms = job.merger->estimated_relative_rms();
+      job.history.push_back(
+          {{"elapsed_s", job.elapsed_s()},
+           {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
+           {"estimated_relative_rms", rms ? nlohmann::json(*rms) : nlohmann::json(nullptr)}});
+      const auto& q = job.request.quality;
+      if (job.merger->complete()) {
+        stop = "samples";
+      } else if (q.target_relative_error && rms && *rms <= *q.target_relative_error) {
+        stop = "target_error";
+      } else if (q.time_limit_s && job.elapsed_s() >= *q.time_limit_s) {
+        stop = "time_limit";
+      }
+    }
+    if (!stop.empty()) break;
+    // The gate: the next pass may merge only now that this one is complete everywhere.
+    if (stops_early(job) && job.merger->pass_limit() < passes + 1) {
+      job.merger->set_pass_limit(passes + 1);
+      continue;
+    }
+    break;
   }
-  if (!job.active() || !job.merger->complete()) return;
+  if (stop.empty() && job.merger->complete()) stop = "samples";
+  if (stop.empty()) return;
+  drop_attempts_of(job);
+  job.merger->drop_waiting();
   write_images(job, true);
   job.preview_units = job.merger->merged_units();
-  job.stopped_by = "samples";
+  job.stopped_by = stop;
   set_state(job, "done");
   emit(job, "done");
 }

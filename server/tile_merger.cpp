@@ -46,22 +46,43 @@ bool TileMerger::received(const WorkUnit& u) const {
 bool TileMerger::add(const WorkUnit& u, FilmTile film) {
   const auto t = static_cast<std::size_t>(u.tile);
   if (received(u)) return false;
-  FilmTile& target = tile(u.tile);
-  if (film.x0() != target.x0() || film.y0() != target.y0() || film.width() != target.width() ||
-      film.height() != target.height() || film.batches() != target.batches())
+  if (film.x0() != tile_x0(u.tile) || film.y0() != tile_y0(u.tile) || film.batches() != plan_.batches)
     throw FilmTileDecodeError("result tile does not match tile " + std::to_string(u.tile) + " of the plan");
   waiting_[t].emplace(index_of(u), std::move(film));
-  // Merge every waiting result that is next in canonical order.
-  bool advanced = false;
-  for (auto it = waiting_[t].find(next_index_[t]); it != waiting_[t].end(); it = waiting_[t].find(next_index_[t])) {
+  merge_ready(u.tile);
+  return true;
+}
+
+// Merges the tile's waiting results that are next in canonical order and
+// within the pass limit; writes the tile if it advanced.
+void TileMerger::merge_ready(int tile_index) {
+  const auto t = static_cast<std::size_t>(tile_index);
+  auto it = waiting_[t].find(next_index_[t]);
+  if (it == waiting_[t].end() || next_index_[t] / plan_.batches > pass_limit_) return;
+  FilmTile& target = tile(tile_index);
+  for (; it != waiting_[t].end() && next_index_[t] / plan_.batches <= pass_limit_;
+       it = waiting_[t].find(next_index_[t])) {
+    if (it->second.width() != target.width() || it->second.height() != target.height()) {
+      waiting_[t].erase(it);  // cannot happen for results that passed add()
+      continue;
+    }
     target.merge(it->second);
     waiting_[t].erase(it);
     ++next_index_[t];
     ++merged_units_;
-    advanced = true;
   }
-  if (advanced) persist(u.tile, target);
-  return true;
+  persist(tile_index, target);
+}
+
+void TileMerger::set_pass_limit(int last_pass) {
+  const int previous = pass_limit_;
+  pass_limit_ = last_pass;
+  if (last_pass <= previous) return;
+  for (int t = 0; t < plan_.tile_count(); ++t) merge_ready(t);
+}
+
+void TileMerger::drop_waiting() {
+  for (auto& w : waiting_) w.clear();
 }
 
 int TileMerger::complete_passes() const {
@@ -82,6 +103,18 @@ std::optional<double> TileMerger::estimated_relative_rms() const {
 
 // File: magic, version, units merged (little-endian uint32 each), then the
 // FilmTile's own serialisation (which carries a CRC).
+int TileMerger::tile_x0(int t) const {
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  plan_.tile_rect(t, &x0, &y0, &w, &h);
+  return x0;
+}
+
+int TileMerger::tile_y0(int t) const {
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  plan_.tile_rect(t, &x0, &y0, &w, &h);
+  return y0;
+}
+
 std::filesystem::path TileMerger::tile_path(int t) const { return dir_ / ("tile_" + std::to_string(t) + ".bin"); }
 
 void TileMerger::persist(int t, const FilmTile& film) const {

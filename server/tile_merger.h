@@ -43,6 +43,17 @@ class TileMerger {
   // Merged or waiting in memory.
   bool received(const WorkUnit& unit) const;
 
+  // Units of passes after `last_pass` wait in memory instead of being merged
+  // (default: no limit).  Raising the limit merges what became eligible.
+  // The job service keeps it at (passes complete everywhere) + 1, so that at
+  // the moment a pass completes every tile holds exactly that many passes:
+  // stopping there (target error reached) gives the same image as a local
+  // render stopped after the same pass, whatever the timing.
+  void set_pass_limit(int last_pass);
+  int pass_limit() const { return pass_limit_; }
+  // Forgets results waiting in memory (a job stopped early).
+  void drop_waiting();
+
   int merged_units() const { return merged_units_; }
   int total_units() const { return plan_.unit_count(); }
   bool complete() const { return merged_units_ == total_units(); }
@@ -57,6 +68,9 @@ class TileMerger {
 
  private:
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }
+  void merge_ready(int tile);
+  int tile_x0(int t) const;
+  int tile_y0(int t) const;
   std::filesystem::path tile_path(int tile) const;
   void persist(int tile, const FilmTile& film) const;
   void load();
@@ -74,6 +88,7 @@ class TileMerger {
   std::vector<int> next_index_;                   // per tile: units merged
   std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
   int merged_units_ = 0;
+  int pass_limit_ = 1 << 30;
 };
 
 }  // namespace skyfarm::server

@@ -84,11 +84,23 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
                label.c_str(), plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
                scene.sun().zenith_deg(), scene.sun().azimuth_deg());
   ProgressDisplay progress(label);
-  const LocalRenderResult result =
-      render_image(renderer, &image, threads, [&](int done, int total) { progress.update(done, total); });
+  const auto on_progress = [&](int done, int total) { progress.update(done, total); };
+  LocalRenderResult result;
+  int samples = plan.samples_per_pixel;
+  std::string stopped_by = "samples";
+  if (request.quality.target_relative_error || request.quality.time_limit_s) {
+    // Pass by pass over the whole frame, stopping like the farm does.
+    const ProgressiveResult r = render_image_progressive(
+        renderer, &image, threads, {request.quality.target_relative_error, request.quality.time_limit_s}, on_progress);
+    result = r;
+    samples = std::min(plan.samples_per_pixel, r.passes * plan.samples_per_pass);
+    stopped_by = r.stopped_by;
+  } else {
+    result = render_image(renderer, &image, threads, on_progress);
+  }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  api::set_render_metadata(&image, request, plan, scene.sun(), plan.samples_per_pixel, result.estimate);
+  api::set_render_metadata(&image, request, plan, scene.sun(), samples, result.estimate);
 
   ExrWriteOptions exr;
   exr.half = request.output.half;
@@ -109,9 +121,10 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
     std::printf("wrote %s (exposure EV100 %.2f)\n", png_path.c_str(), r.exposure_ev);
   }
   const double paths = static_cast<double>(result.counters.paths);
-  std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f\n",
+  std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f, "
+              "%d samples per pixel, stopped by %s\n",
               seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(threads),
-              result.estimated_relative_rms);
+              result.estimated_relative_rms, samples, stopped_by.c_str());
   if (result.counters.nonfinite > 0)
     std::printf("warning: %llu non-finite or negative path results were discarded\n",
                 static_cast<unsigned long long>(result.counters.nonfinite));

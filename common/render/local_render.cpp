@@ -1,5 +1,6 @@
 #include "common/render/local_render.h"
 
+#include <chrono>
 #include <cmath>
 #include <mutex>
 #include <vector>
@@ -39,6 +40,52 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
   r.pixels_without_estimate = error.unknown;
   r.estimate = error.relative_rms();
   r.estimated_relative_rms = r.estimate.value_or(0.0);
+  return r;
+}
+
+ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* image, int threads,
+                                           const StopCriteria& stop, const RenderProgress& progress) {
+  const RenderPlan& plan = renderer.plan();
+  const int tiles = plan.tile_count();
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<FilmTile> film;
+  for (int t = 0; t < tiles; ++t) film.push_back(renderer.empty_tile(t));
+  std::vector<PathCounters> counters(static_cast<std::size_t>(tiles));
+  ProgressiveResult r;
+  r.stopped_by = "samples";
+  int done = 0;
+  std::mutex mutex;
+  for (int p = 0; p < plan.passes; ++p) {
+    parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
+      FilmTile pass = renderer.empty_tile(static_cast<int>(t));
+      for (int b = 0; b < plan.batches; ++b)
+        renderer.render_unit({static_cast<int>(t), b, p}, &pass, &counters[t]);
+      film[t].merge(pass);
+      if (progress) {
+        const std::lock_guard<std::mutex> lock(mutex);
+        progress(++done, tiles * plan.passes);
+      }
+    });
+    r.passes = p + 1;
+    ErrorSums error;
+    for (const auto& tile : film) error.add(error_sums(tile));  // tile order: deterministic
+    r.estimate = error.relative_rms();
+    r.estimated_relative_rms = r.estimate.value_or(0.0);
+    r.pixels_without_estimate = error.unknown;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    r.history.emplace_back(elapsed, r.estimated_relative_rms);
+    if (p + 1 == plan.passes) break;
+    if (stop.target_relative_error && r.estimate && *r.estimate <= *stop.target_relative_error) {
+      r.stopped_by = "target_error";
+      break;
+    }
+    if (stop.time_limit_s && elapsed >= *stop.time_limit_s) {
+      r.stopped_by = "time_limit";
+      break;
+    }
+  }
+  for (const auto& tile : film) image->resolve(tile);
+  for (const auto& c : counters) r.counters.add(c);
   return r;
 }
 

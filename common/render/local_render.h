@@ -7,6 +7,9 @@
 #pragma once
 #include <functional>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "common/film/image.h"
 #include "common/render/tile_renderer.h"
@@ -25,5 +28,26 @@ struct LocalRenderResult {
 
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,
                                const RenderProgress& progress = {});
+
+// When to stop before the plan's last sample (DESIGN §6 quality modes): after
+// the first whole pass at which the estimated relative RMS error is at most
+// the target, or the first whole pass completed after the time limit.
+struct StopCriteria {
+  std::optional<double> target_relative_error;
+  std::optional<double> time_limit_s;
+};
+
+struct ProgressiveResult : LocalRenderResult {
+  int passes = 0;             // passes rendered (every tile)
+  std::string stopped_by;     // "samples", "target_error" or "time_limit"
+  std::vector<std::pair<double, double>> history;  // (elapsed s, estimate) after each pass
+};
+
+// Renders pass by pass over the whole frame (all tiles of pass p before any
+// of pass p + 1) and stops by `stop`; the same passes and stopping rule as the
+// farm, so the same request gives the same bytes.  Keeps the whole film in
+// memory (width x height x batches x 48 bytes), unlike render_image().
+ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* image, int threads,
+                                           const StopCriteria& stop, const RenderProgress& progress = {});
 
 }  // namespace skyfarm

@@ -268,3 +268,62 @@ TEST(JobService, HigherPriorityJobsGoFirst) {
 
 }  // namespace
 }  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// Quality modes (DESIGN §6): a target error stops the job at the first whole
+// pass whose estimate meets it, with the same bytes as a local render that
+// stops by the same rule, whatever order the results arrive in.
+TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {
+  // Looking away from the sun: the estimate falls as 1/sqrt(samples)
+  // (0.22 after one pass of 16, 0.11 at 64, 0.078 at 128), so 0.1 stops
+  // after 5 of the 16 passes.
+  constexpr const char* kTargeted = R"({
+    "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "perspective", "width": 40, "height": 20, "yaw_deg": 320, "pitch_deg": 10,
+               "fov_deg": 60},
+    "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 256, "target_relative_error": 0.1},
+    "output": {"half": false},
+    "seed": 5
+  })";
+  const fs::path dir = fresh_dir("target");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kTargeted), std::nullopt).id;
+  std::mt19937 rng(12);
+  run_shuffled(service, rng, 9);
+  const auto s = *service.status(id);
+  ASSERT_EQ(s["state"], "done");
+  EXPECT_EQ(s["stopped_by"], "target_error");
+  EXPECT_LT(s["progress"]["samples_per_pixel"].get<int>(), 256);
+  EXPECT_LE(s["error"]["estimated_relative_rms"].get<double>(), 0.1);
+  EXPECT_EQ(s["progress"]["samples_per_pixel"], 80);
+  // The history falls pass after pass, the last entry at the target.
+  const auto& h = s["error"]["history"];
+  ASSERT_GE(h.size(), 2u);
+  EXPECT_GT(h[0]["estimated_relative_rms"].get<double>(), h.back()["estimated_relative_rms"].get<double>());
+
+  fs::create_directories(dir / "local");
+  std::ofstream(dir / "local" / "request.json") << kTargeted;
+  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "local" / "request.json").string() +
+                          " -o " + (dir / "local" / "local.exr").string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), read_file(dir / "local" / "local.exr"));
+}
+
+TEST(JobService, TimeLimitStopsAtTheNextWholePass) {
+  auto request = api::parse_render_request(kRequest);
+  request.quality.time_limit_s = 1e-9;  // already over when the first pass completes
+  JobService service(fresh_dir("time"));
+  const auto id = service.submit(request, std::nullopt).id;
+  std::mt19937 rng(2);
+  run_shuffled(service, rng, 3);
+  const auto s = *service.status(id);
+  ASSERT_EQ(s["state"], "done");
+  EXPECT_EQ(s["stopped_by"], "time_limit");
+  EXPECT_EQ(s["progress"]["samples_per_pixel"], 16) << "one whole pass";
+}
+
+}  // namespace
+}  // namespace skyfarm::server
