@@ -14,6 +14,7 @@
 #include "api/render_setup.h"
 #include "common/render/local_render.h"
 #include "common/render/parallel.h"
+#include "worker/bench_convergence.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
 
@@ -112,10 +113,13 @@ int run_bench_command(const std::vector<std::string>& args) {
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--repeat" && i + 1 < args.size()) {
       repeat = std::max(1, std::atoi(args[++i].c_str()));
+    } else if (args[i] == "convergence") {
+      return run_bench_convergence(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "paths" || args[i] == "demo" || args[i] == "memory" || args[i] == "all") {
       which = args[i];
     } else {
-      std::cerr << "usage: skyfarm-worker bench [paths|demo|memory|all] [--repeat N]\n";
+      std::cerr << "usage: skyfarm-worker bench [paths|demo|memory|all] [--repeat N]\n"
+                   "       skyfarm-worker bench convergence [--out DIR] [--passes N]\n";
       return 2;
     }
   }

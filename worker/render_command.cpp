@@ -91,7 +91,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   if (request.quality.target_relative_error || request.quality.time_limit_s) {
     // Pass by pass over the whole frame, stopping like the farm does.
     const ProgressiveResult r = render_image_progressive(
-        renderer, &image, threads, {request.quality.target_relative_error, request.quality.time_limit_s}, on_progress);
+        renderer, &image, threads, {request.quality.target_relative_error, request.quality.time_limit_s, {}}, on_progress);
     result = r;
     samples = std::min(plan.samples_per_pixel, r.passes * plan.samples_per_pass);
     stopped_by = r.stopped_by;

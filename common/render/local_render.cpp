@@ -74,6 +74,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     r.pixels_without_estimate = error.unknown;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.history.emplace_back(elapsed, r.estimated_relative_rms);
+    if (stop.after_pass) stop.after_pass(p + 1, film, elapsed);
     if (p + 1 == plan.passes) break;
     if (stop.target_relative_error && r.estimate && *r.estimate <= *stop.target_relative_error) {
       r.stopped_by = "target_error";

@@ -1,0 +1,233 @@
+#include "worker/bench_convergence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "api/render_setup.h"
+#include "common/image/exr_writer.h"
+#include "common/image/png_writer.h"
+#include "common/film/error_estimate.h"
+#include "common/render/local_render.h"
+
+namespace skyfarm {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Scene_ {
+  const char* name;
+  const char* json;  // without quality and seed
+};
+
+// Small frames (64x32 equirect, 1 batch) so references converge in minutes.
+const Scene_ kScenes[] = {
+    {"noon", R"("sun": {"zenith_deg": 30, "azimuth_deg": 180})"},
+    {"sun85", R"("sun": {"zenith_deg": 85, "azimuth_deg": 180})"},
+    {"sunset", R"("sun": {"zenith_deg": 90, "azimuth_deg": 180})"},
+    {"twilight96", R"("sun": {"zenith_deg": 96, "azimuth_deg": 180})"},
+    {"orbit400km", R"("sun": {"zenith_deg": 45, "azimuth_deg": 180}, "location": {"altitude_m": 400000})"},
+    {"haze", R"("sun": {"zenith_deg": 40, "azimuth_deg": 180}, "atmosphere": {"aerosol": {"optical_depth_550": 0.5}})"},
+};
+
+std::string request_json(const Scene_& s, int spp, int seed) {
+  return std::string("{") + s.json +
+         R"(, "camera": {"projection": "equirectangular", "width": 64, "height": 32}, "spectral": {"batches": 1},)"
+         R"( "quality": {"samples_per_pixel": )" + std::to_string(spp) + R"(}, "output": {"half": false}, "seed": )" +
+         std::to_string(seed) + "}";
+}
+
+// Luminance per pixel of a film (0 where never traced).
+std::vector<double> luminance_of(const std::vector<FilmTile>& film, int width, int height) {
+  std::vector<double> Y(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0);
+  for (const auto& tile : film)
+    for (int y = tile.y0(); y < tile.y0() + tile.height(); ++y)
+      for (int x = tile.x0(); x < tile.x0() + tile.width(); ++x)
+        if (const auto m = tile.mean_xyz(x, y)) Y[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = m->y;
+  return Y;
+}
+
+// The sun disk's pixels (a 5x5 block around its centre): a few pixels 1e6
+// times brighter than the sky, hit or missed by chance, would otherwise be
+// the whole luminance-weighted error.  Both errors leave them out.
+std::vector<bool> sky_mask(const api::RenderSetup& setup) {
+  std::vector<bool> keep(64 * 32, true);
+  double fx = 0.0, fy = 0.0;
+  if (!setup.scene->sun().is_point() && setup.camera->direction_to_film(setup.scene->sun().direction(), &fx, &fy))
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx) {
+        const int x = (static_cast<int>(fx) + dx + 64) % 64, y = static_cast<int>(fy) + dy;
+        if (y >= 0 && y < 32) keep[static_cast<std::size_t>(y * 64 + x)] = false;
+      }
+  return keep;
+}
+
+// True luminance-weighted relative RMS error: sqrt(sum (Y - Y_ref)^2 / sum Y_ref^2).
+double true_error(const std::vector<double>& Y, const std::vector<double>& ref, const std::vector<bool>& keep) {
+  double num = 0.0, den = 0.0;
+  for (std::size_t i = 0; i < Y.size(); ++i) {
+    if (!keep[i]) continue;
+    num += (Y[i] - ref[i]) * (Y[i] - ref[i]);
+    den += ref[i] * ref[i];
+  }
+  return den > 0.0 ? std::sqrt(num / den) : 0.0;
+}
+
+// The renderer's own estimate over the same pixels: sqrt(sum var(Y_i) / sum Y_i^2).
+double estimated_error(const std::vector<FilmTile>& film, const std::vector<bool>& keep) {
+  double var_sum = 0.0, y2 = 0.0;
+  for (const auto& tile : film)
+    for (int y = tile.y0(); y < tile.y0() + tile.height(); ++y)
+      for (int x = tile.x0(); x < tile.x0() + tile.width(); ++x) {
+        if (!keep[static_cast<std::size_t>(y * 64 + x)]) continue;
+        const auto m = tile.mean_xyz(x, y);
+        const auto v = tile.luminance_variance_of_mean(x, y);
+        if (!m || !v) continue;
+        var_sum += *v;
+        y2 += m->y * m->y;
+      }
+  return y2 > 0.0 ? std::sqrt(var_sum / y2) : 0.0;
+}
+
+// The reference: many passes with another seed, cached as raw doubles.
+std::vector<double> reference(const Scene_& s, int passes, const fs::path& dir) {
+  const fs::path cache = dir / (std::string(s.name) + "_reference_" + std::to_string(passes) + ".bin");
+  std::vector<double> Y(64 * 32, 0.0);
+  if (std::ifstream in(cache, std::ios::binary); in && in.read(reinterpret_cast<char*>(Y.data()), Y.size() * sizeof(double)))
+    return Y;
+  const auto request = api::parse_render_request(request_json(s, passes * 16, 987654321));
+  const api::RenderSetup setup = api::make_render_setup(request);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  StopCriteria stop;
+  stop.after_pass = [&](int pass, const std::vector<FilmTile>& film, double) {
+    if (pass == setup.plan.passes) Y = luminance_of(film, 64, 32);
+  };
+  Image image(64, 32);
+  render_image_progressive(renderer, &image, 0, stop);
+  std::ofstream(cache, std::ios::binary).write(reinterpret_cast<const char*>(Y.data()), static_cast<std::streamsize>(Y.size() * sizeof(double)));
+  return Y;
+}
+
+// A log-log plot of true (red) and estimated (blue) error against time.
+void plot(const std::vector<double>& t, const std::vector<double>& truth, const std::vector<double>& est,
+          const fs::path& path) {
+  const int W = 480, H = 320, M = 30;
+  Image img(W, H);
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) img.set_rgb(x, y, Rgb{1.0, 1.0, 1.0});
+  double lt0 = 1e300, lt1 = -1e300, le0 = 1e300, le1 = -1e300;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    lt0 = std::min(lt0, std::log10(t[i]));
+    lt1 = std::max(lt1, std::log10(t[i]));
+    for (double e : {truth[i], est[i]}) {
+      if (e <= 0.0) continue;
+      le0 = std::min(le0, std::log10(e));
+      le1 = std::max(le1, std::log10(e));
+    }
+  }
+  if (lt1 <= lt0) lt1 = lt0 + 1.0;
+  if (le1 <= le0) le1 = le0 + 1.0;
+  auto px = [&](double ti, double e, int* x, int* y) {
+    *x = M + static_cast<int>((std::log10(ti) - lt0) / (lt1 - lt0) * (W - 2 * M));
+    *y = H - M - static_cast<int>((std::log10(std::max(e, 1e-300)) - le0) / (le1 - le0) * (H - 2 * M));
+  };
+  auto line = [&](int x0, int y0, int x1, int y1, Rgb c) {
+    const int n = std::max(std::abs(x1 - x0), std::abs(y1 - y0)) + 1;
+    for (int k = 0; k <= n; ++k) {
+      const int x = x0 + (x1 - x0) * k / n, y = y0 + (y1 - y0) * k / n;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (x + dx >= 0 && x + dx < W && y + dy >= 0 && y + dy < H) img.set_rgb(x + dx, y + dy, c);
+    }
+  };
+  line(M, H - M, W - M, H - M, Rgb{0, 0, 0});  // axes
+  line(M, M, M, H - M, Rgb{0, 0, 0});
+  for (std::size_t i = 1; i < t.size(); ++i) {
+    int x0, y0, x1, y1;
+    px(t[i - 1], truth[i - 1], &x0, &y0);
+    px(t[i], truth[i], &x1, &y1);
+    line(x0, y0, x1, y1, Rgb{0.8, 0.05, 0.05});
+    px(t[i - 1], est[i - 1], &x0, &y0);
+    px(t[i], est[i], &x1, &y1);
+    line(x0, y0, x1, y1, Rgb{0.05, 0.1, 0.8});
+  }
+  PngWriteOptions o;
+  o.exposure_ev = 3.0 + std::log2(0.18);  // scale 1: values are display values
+  write_png(img, path, o);
+}
+
+// Least-squares slope of log(error) against log(time).
+double fitted_slope(const std::vector<double>& t, const std::vector<double>& e) {
+  double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (e[i] <= 0.0 || t[i] <= 0.0) continue;
+    const double x = std::log(t[i]), y = std::log(e[i]);
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+    n += 1;
+  }
+  return n > 1 ? (n * sxy - sx * sy) / (n * sxx - sx * sx) : 0.0;
+}
+
+}  // namespace
+
+int run_bench_convergence(const std::vector<std::string>& args) {
+  fs::path dir = "skyfarm-convergence";
+  int passes = 32;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--out" && i + 1 < args.size()) dir = args[++i];
+    else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
+    else if (args[i] != "convergence") {
+      std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N]\n";
+      return 2;
+    }
+  }
+  fs::create_directories(dir);
+  for (const Scene_& s : kScenes) {
+    const std::vector<double> ref = reference(s, passes * 16, dir);
+    const auto request = api::parse_render_request(request_json(s, passes * 16, 1));
+    const api::RenderSetup setup = api::make_render_setup(request);
+    const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+    const std::vector<bool> keep = sky_mask(setup);
+    std::vector<double> times, truths, estimates;
+    std::ofstream csv(dir / (std::string(s.name) + ".csv"));
+    csv << "elapsed_s,samples_per_pixel,true_relative_rms,estimated_relative_rms\n";
+    StopCriteria stop;
+    stop.after_pass = [&](int pass, const std::vector<FilmTile>& film, double elapsed) {
+      const double est = estimated_error(film, keep);
+      const double truth = true_error(luminance_of(film, 64, 32), ref, keep);
+      times.push_back(elapsed);
+      truths.push_back(truth);
+      estimates.push_back(est);
+      csv << elapsed << "," << pass * 16 << "," << truth << "," << est << "\n";
+    };
+    Image image(64, 32);
+    render_image_progressive(renderer, &image, 0, stop);
+    plot(times, truths, estimates, dir / (std::string(s.name) + ".png"));
+    double worst = 1.0;
+    for (std::size_t i = 0; i < truths.size(); ++i)
+      if (truths[i] > 0.0 && estimates[i] > 0.0)
+        worst = std::max(worst, std::max(estimates[i] / truths[i], truths[i] / estimates[i]));
+    const double efficiency = truths.back() > 0.0 ? 1.0 / (truths.back() * truths.back() * times.back()) : 0.0;
+    std::cout << nlohmann::json{{"bench", "convergence"},
+                                {"scene", s.name},
+                                {"final_true_relative_rms", truths.back()},
+                                {"final_estimated_relative_rms", estimates.back()},
+                                {"seconds", times.back()},
+                                {"fitted_slope", fitted_slope(times, truths)},
+                                {"worst_estimate_ratio", worst},
+                                {"efficiency_1_over_err2_time", efficiency}}
+                     .dump()
+              << std::endl;
+  }
+  return 0;
+}
+
+}  // namespace skyfarm
