@@ -15,6 +15,7 @@
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
 #include "common/render/render_plan.h"
+#include "common/render/sun_pixels.h"
 #include "common/sampling/sampler.h"
 #include "server/job_store.h"
 #include "server/tile_merger.h"
@@ -108,6 +109,7 @@ struct Job {
   std::string stopped_by;
   int preview_units = -1;
   fs::path dir;
+  std::vector<std::uint32_t> sun_pixels;  // left out of the error estimate
 
   std::size_t unit_index(const WorkUnit& u) const {
     return (static_cast<std::size_t>(u.pass) * static_cast<std::size_t>(plan.tile_count()) +
@@ -200,6 +202,11 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
                                request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
                                request.seed);
   job->plan_json = plan_report(request, job->plan);
+  {
+    const Camera camera(request.camera,
+                        {0.0, 0.0, request.atmosphere.planet_radius_m + request.location.altitude_m});
+    job->sun_pixels = sun_pixels(camera, Sun::from_spec(request.sun, request.location, request.time));
+  }
   job->dir = data_dir / "jobs" / record.id;
   job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
   job->passes_reported = job->merger->complete_passes();
@@ -381,7 +388,7 @@ void JobService::Impl::write_images(Job& job, bool final) {
   api::set_render_metadata(&image, job.request, job.plan, sun,
                            std::min(job.plan.samples_per_pixel,
                                     job.merger->complete_passes() * job.plan.samples_per_pass),
-                           job.merger->estimated_relative_rms());
+                           job.merger->estimated_relative_rms(job.sun_pixels));
   try {
     ExrWriteOptions exr;
     exr.half = out.half;
@@ -583,7 +590,7 @@ void JobService::Impl::finish_if_complete(Job& job) {
     const int passes = job.merger->complete_passes();
     if (passes > job.passes_reported) {
       job.passes_reported = passes;
-      const auto rms = job.merger->estimated_relative_rms();
+      const auto rms = job.merger->estimated_relative_rms(job.sun_pixels);
       job.history.push_back(
           {{"elapsed_s", job.elapsed_s()},
            {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},

@@ -95,9 +95,9 @@ void TileMerger::resolve(Image* image) const {
   for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(tile(t));
 }
 
-std::optional<double> TileMerger::estimated_relative_rms() const {
+std::optional<double> TileMerger::estimated_relative_rms(const std::vector<std::uint32_t>& excluded) const {
   ErrorSums sums;
-  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(error_sums(tile(t)));
+  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(error_sums(tile(t), excluded, plan_.width));
   return sums.relative_rms();
 }
 

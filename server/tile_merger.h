@@ -63,8 +63,9 @@ class TileMerger {
 
   // Resolves every tile into `image` (sizes must match).
   void resolve(Image* image) const;
-  // sqrt(sum_i var(Y_i) / sum_i Y_i^2) over pixels with an estimate, or nullopt.
-  std::optional<double> estimated_relative_rms() const;
+  // sqrt(sum_i var(Y_i) / sum_i Y_i^2) over pixels with an estimate, or
+  // nullopt; `excluded` are the sun disk's pixels (render/sun_pixels.h).
+  std::optional<double> estimated_relative_rms(const std::vector<std::uint32_t>& excluded = {}) const;
 
  private:
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }

@@ -5,7 +5,9 @@
 // over the pixels that have an estimate.  Sums are formed per tile and then
 // added in tile order, so every caller (local render, farm) gets the same bits.
 #pragma once
+#include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "common/film/film_tile.h"
 
@@ -23,6 +25,8 @@ struct ErrorSums {
   std::optional<double> relative_rms() const;
 };
 
-ErrorSums error_sums(const FilmTile& tile);
+// `excluded`: sorted pixel indices y * image_width + x to leave out (the sun
+// disk's pixels, render/sun_pixels.h).
+ErrorSums error_sums(const FilmTile& tile, const std::vector<std::uint32_t>& excluded = {}, int image_width = 0);
 
 }  // namespace skyfarm

@@ -24,7 +24,7 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
   parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
     TileStats& s = stats[t];
     const FilmTile film = renderer.render_tile(static_cast<int>(t), &s.counters);
-    s.error = error_sums(film);
+    s.error = error_sums(film, renderer.sun_pixels(), plan.width);
     image->resolve(film);  // disjoint pixels per tile
     if (progress) {
       const std::lock_guard<std::mutex> lock(mutex);
@@ -68,7 +68,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     });
     r.passes = p + 1;
     ErrorSums error;
-    for (const auto& tile : film) error.add(error_sums(tile));  // tile order: deterministic
+    for (const auto& tile : film) error.add(error_sums(tile, renderer.sun_pixels(), plan.width));  // tile order
     r.estimate = error.relative_rms();
     r.estimated_relative_rms = r.estimate.value_or(0.0);
     r.pixels_without_estimate = error.unknown;

@@ -1,12 +1,13 @@
 #include "common/render/tile_renderer.h"
 
+#include "common/render/sun_pixels.h"
 #include "common/spectrum/color.h"
 
 namespace skyfarm {
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
                            IntegratorOptions options)
-    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, options) {}
+    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, options), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())) {}
 
 FilmTile TileRenderer::empty_tile(int tile) const {
   int x0 = 0, y0 = 0, w = 0, h = 0;

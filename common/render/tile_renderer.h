@@ -24,12 +24,15 @@ class TileRenderer {
   FilmTile render_tile(int tile, PathCounters* counters) const;
 
   const RenderPlan& plan() const { return plan_; }
+  // Pixels that see the sun disk, left out of the image-level error estimate.
+  const std::vector<std::uint32_t>& sun_pixels() const { return sun_pixels_; }
 
  private:
   const Scene& scene_;
   const Camera& camera_;
   RenderPlan plan_;
   VolumePathIntegrator integrator_;
+  std::vector<std::uint32_t> sun_pixels_;
 };
 
 }  // namespace skyfarm
