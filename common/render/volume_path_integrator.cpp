@@ -300,7 +300,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
               T_ray *= 1.0 / (1.0 - q);
           }
           return !T_ray.is_zero();
-        });
+        },
+        options_.shadow_majorant_scale);
     if (T_ray.is_zero()) return SampledSpectrum(0.0);
     const double T0 = T_maj[0];
     T_ray *= T_maj * (1.0 / T0);

@@ -47,6 +47,10 @@ struct IntegratorOptions {
   // gathers the sun in expectation at about this many points (see the .cpp).
   double camera_target_collisions = 1.0;
   double max_camera_majorant_scale = 8.0;
+  // Inflation of the (coarse) majorants on shadow rays: ratio tracking's
+  // relative variance is about exp(tau / scale) - 1, so looser bounds trade
+  // collisions for much less noise on long, grazing shadow rays.
+  double shadow_majorant_scale = 1.0;
 };
 
 // Counters a renderer sums over its paths.
