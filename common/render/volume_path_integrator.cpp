@@ -111,11 +111,19 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
 
   SampledSpectrum L(0.0), beta(1.0), r_u(1.0), r_l(1.0);
   bool mis_with_sun = false;  // the previous vertex sampled the sun (NEE)
+  // Single scattering along the camera ray comes from its own estimator
+  // (sunlit_single_scattering); the delta-tracked path then carries only
+  // light scattered twice or more: no sun at its first medium vertex, and no
+  // sun disk seen right after it.
+  const bool explicit_single = options_.explicit_single_scattering && scene_.sun_enabled;
+  bool after_first_medium_vertex = false;
   MediumPoint mp;
 
   for (int depth = 0;; ++depth) {
     const RayExtent extent = ray_extent(ray, atmosphere);
     bool scattered = false, absorbed = false;
+    if (depth == 0 && explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
+      L += sunlit_single_scattering(ray, extent.t_begin, extent.t_end, lambda, path, phases, sampler, counters);
 
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
@@ -127,7 +135,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
             // The sun gathered here in expectation: P_s times the NEE of the
             // real-scattering branch (throughput and r_u of that branch).
-            if (scene_.sun_enabled && p_scatter > 0.0) {
+            if (scene_.sun_enabled && p_scatter > 0.0 && !(explicit_single && depth == 0)) {
               const double pdf = T_maj_seg[0] * mp.sigma_s[0];
               const SampledSpectrum beta_s = beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
               const SampledSpectrum r_u_s = r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
@@ -176,6 +184,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
               r_u *= ratio;
               ray = Ray{p, wi};
               scattered = true;
+              after_first_medium_vertex = explicit_single && depth == 0;
               return false;
             }
             // Null collision.
@@ -216,7 +225,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
         ray = Ray{p, wi};
       } else {
         // --- Escaped: the sun disk (with MIS if the last vertex sampled it) and the environment.
-        if (scene_.sun_enabled && sun.contains(ray.d)) {
+        if (scene_.sun_enabled && sun.contains(ray.d) && !after_first_medium_vertex) {
           const SampledSpectrum& Le = path.sun_radiance;
           if (!mis_with_sun) {
             L += beta * Le * (1.0 / r_u.average());
@@ -231,6 +240,8 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
       }
     }
     mis_with_sun = scene_.sun_enabled && !sun.is_point();
+    if (!scattered) after_first_medium_vertex = false;  // a ground bounce ends the exclusion
+    else if (depth > 0) after_first_medium_vertex = false;
 
     // --- Russian roulette on the MIS-normalised throughput.
     if (beta.is_zero()) return L;
@@ -315,6 +326,102 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (sun.is_point()) return Ld * (1.0 / r_l.average());
   const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
   return Ld * (1.0 / (r_l + r_u).average());
+}
+
+// Single scattering of sunlight along a camera ray, sampled where the sun is
+// visible (DESIGN §3.4; issue 5 "sampling the distance towards the sun"):
+//   L_ss = int_sunlit T(o, x_t) sigma_s(x_t) p(theta) T(x_t, sun) L_sun dt.
+// The sunlit part of [t0, t1] is the line minus the planet's shadow cylinder
+// (points x with x.s < 0 and |x - (x.s) s| < R, s towards the sun), at most
+// two intervals found in closed form.  Within them t is drawn proportionally
+// to the hero wavelength's majorant (so mostly at the lowest sunlit
+// altitudes), pdf(t) = sigma_maj(t) / tau_maj(sunlit); the transmittances
+// are unbiased ratio-tracking estimates, the sun direction is sampled on the
+// disk.  When the sun is below the horizon this puts every sample where the
+// light is, instead of waiting for a rare collision high up.
+SampledSpectrum VolumePathIntegrator::sunlit_single_scattering(const Ray& ray, double t0, double t1,
+                                                               const SampledWavelengths& lambda,
+                                                               const PathCoefficients& path, const PathPhases& phases,
+                                                               Sampler& sampler, PathCounters* counters) const {
+  const AtmosphereMedium& medium = scene_.medium();
+  const double R = scene_.atmosphere().planet_radius_m();
+  const glm::dvec3 s = scene_.sun().direction();
+  // Shadow cylinder: perp^2(t) = A t^2 + 2 B t + C' with C' = |o|^2 - (o.s)^2; inside when < R^2.
+  const double os = glm::dot(ray.o, s), ds = glm::dot(ray.d, s);
+  const double A = 1.0 - ds * ds, B = glm::dot(ray.o, ray.d) - os * ds;
+  const double C = (glm::dot(ray.o, ray.o) - os * os) - R * R;
+  double c0 = 1.0, c1 = 0.0;  // inside-cylinder interval (empty if c0 > c1)
+  if (A > 1e-12) {
+    const double disc = B * B - A * C;
+    if (disc > 0.0) {
+      const double root = std::sqrt(disc);
+      c0 = (-B - root) / A;
+      c1 = (-B + root) / A;
+    }
+  } else if (C < 0.0) {
+    c0 = -1e300;
+    c1 = 1e300;
+  }
+  // Behind the planet: x.s < 0, i.e. os + t ds < 0.
+  double h0 = -1e300, h1 = 1e300;
+  if (ds > 0.0) h1 = -os / ds;
+  else if (ds < 0.0) h0 = -os / ds;
+  else if (os >= 0.0) {  // never behind the planet: an empty half-space
+    h0 = 1.0;
+    h1 = 0.0;
+  }
+  const double shadow0 = std::max(c0, h0), shadow1 = std::min(c1, h1);
+  std::array<std::pair<double, double>, 2> lit{};
+  int n_lit = 0;
+  if (!(shadow0 < shadow1) || shadow1 <= t0 || shadow0 >= t1) {
+    lit[n_lit++] = {t0, t1};
+  } else {
+    if (shadow0 > t0) lit[n_lit++] = {t0, shadow0};
+    if (shadow1 < t1) lit[n_lit++] = {shadow1, t1};
+  }
+  // The hero's majorant optical depth of the sunlit intervals.
+  const ShellMajorants& shells = medium.fine_shells();
+  double tau_lit = 0.0;
+  for (int k = 0; k < n_lit; ++k) {
+    ShellTraversal walk(ray, R, shells.bottoms, lit[static_cast<std::size_t>(k)].first,
+                        lit[static_cast<std::size_t>(k)].second);
+    ShellSegment seg;
+    while (walk.next(&seg)) tau_lit += shells.sigma_maj(seg.shell, path.bins)[0] * (seg.t1 - seg.t0);
+  }
+  const double u_t = sampler.next(), u_s1 = sampler.next(), u_s2 = sampler.next();
+  if (!(tau_lit > 0.0)) return SampledSpectrum(0.0);
+  // Invert: the point where the majorant optical depth reaches u tau_lit.
+  double target = u_t * tau_lit, t = -1.0, sigma_maj0 = 0.0;
+  for (int k = 0; k < n_lit && t < 0.0; ++k) {
+    ShellTraversal walk(ray, R, shells.bottoms, lit[static_cast<std::size_t>(k)].first,
+                        lit[static_cast<std::size_t>(k)].second);
+    ShellSegment seg;
+    while (walk.next(&seg)) {
+      const double m = shells.sigma_maj(seg.shell, path.bins)[0];
+      const double tau_seg = m * (seg.t1 - seg.t0);
+      if (m > 0.0 && target <= tau_seg) {
+        t = seg.t0 + target / m;
+        sigma_maj0 = m;
+        break;
+      }
+      target -= tau_seg;
+    }
+  }
+  if (t < 0.0 || !(sigma_maj0 > 0.0)) return SampledSpectrum(0.0);
+  const double pdf_t = sigma_maj0 / tau_lit;
+  const glm::dvec3 x = ray.at(t);
+  MediumPoint mp;
+  medium.point(glm::length(x) - R, path, &mp);
+  if (mp.sigma_s.is_zero()) return SampledSpectrum(0.0);
+  // The sun: a direction on the disk, blocked by the planet or not.
+  double pdf_light = 0.0;
+  const glm::dvec3 wi = scene_.sun().sample_direction(u_s1, u_s2, &pdf_light);
+  const Ray to_sun{x, wi};
+  if (ground_distance(to_sun, R) >= 0.0) return SampledSpectrum(0.0);
+  const SampledSpectrum p = mixture_phase(mp, phases, clamp_cos(glm::dot(ray.d, wi)));
+  const SampledSpectrum T_cam = transmittance(ray, t, lambda, sampler, counters);
+  const SampledSpectrum T_sun = transmittance(to_sun, 1e300, lambda, sampler, counters);
+  return T_cam * mp.sigma_s * p * T_sun * path.sun_radiance * (1.0 / (pdf_t * pdf_light));
 }
 
 SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda,

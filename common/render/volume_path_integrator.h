@@ -33,6 +33,7 @@
 #include <cstdint>
 
 #include "common/geometry/ray.h"
+#include "common/render/atmosphere_medium.h"
 #include "common/render/scene.h"
 #include "common/sampling/sampler.h"
 #include "common/spectrum/sampled_spectrum.h"
@@ -51,6 +52,13 @@ struct IntegratorOptions {
   // relative variance is about exp(tau / scale) - 1, so looser bounds trade
   // collisions for much less noise on long, grazing shadow rays.
   double shadow_majorant_scale = 1.0;
+  // Single scattering along camera rays from its own estimator, sampled in
+  // the sunlit part of the ray (see the .cpp); the tracked path then carries
+  // the higher orders.  Off by default: measured on the Earth preset at
+  // 550 nm it matched the default estimator's efficiency for zenith views at
+  // noon, lost 30-40 % at 60-85 deg, and did not help at twilight (sun at
+  // 96 deg), where light scattered twice or more dominates the sky.
+  bool explicit_single_scattering = false;
 };
 
 // Counters a renderer sums over its paths.
@@ -89,6 +97,9 @@ class VolumePathIntegrator {
   struct Vertex;
   SampledSpectrum radiance_unchecked(Ray ray, const SampledWavelengths& lambda, Sampler& sampler,
                                      PathCounters* counters) const;
+  SampledSpectrum sunlit_single_scattering(const Ray& ray, double t0, double t1, const SampledWavelengths& lambda,
+                                           const PathCoefficients& path, const PathPhases& phases, Sampler& sampler,
+                                           PathCounters* counters) const;
   double camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
                                const std::array<std::size_t, kWavelengthsPerPath>& bins) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
