@@ -303,8 +303,11 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
   nlohmann::json workers_json = nlohmann::json::array();
   for (const auto& [id, n] : job.worker_units) workers_json.push_back({{"id", id}, {"units", n}});
   const std::string self = "/v1/renders/" + job.record.id;
-  nlohmann::json estimate = nullptr;
-  if (!job.history.empty()) estimate = job.history.back()["estimated_relative_rms"];
+  nlohmann::json estimate = nullptr, unknown = nullptr;
+  if (!job.history.empty()) {
+    estimate = job.history.back()["estimated_relative_rms"];
+    unknown = job.history.back()["pixels_without_estimate"];
+  }
   return {{"id", job.record.id},
           {"state", job.record.state},
           {"priority", job.record.priority},
@@ -312,7 +315,11 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
            {{"fraction", fraction}, {"samples_per_pixel", spp}, {"units_done", merged}, {"units_total", total}}},
           {"elapsed_s", elapsed},
           {"eta_s", eta},
-          {"error", {{"estimated_relative_rms", estimate}, {"history", job.history}}},
+          {"error",
+           {{"estimated_relative_rms", estimate},
+            {"pixels_without_estimate", unknown},
+            {"sun_pixels_excluded", job.sun_pixels.size()},
+            {"history", job.history}}},
           {"stopped_by", job.stopped_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.stopped_by)},
           {"plan", job.plan_json},
           {"workers", workers_json},
@@ -590,11 +597,13 @@ void JobService::Impl::finish_if_complete(Job& job) {
     const int passes = job.merger->complete_passes();
     if (passes > job.passes_reported) {
       job.passes_reported = passes;
-      const auto rms = job.merger->estimated_relative_rms(job.sun_pixels);
+      const ErrorSums sums = job.merger->error_sums(job.sun_pixels);
+      const auto rms = sums.relative_rms();
       job.history.push_back(
           {{"elapsed_s", job.elapsed_s()},
            {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
-           {"estimated_relative_rms", rms ? nlohmann::json(*rms) : nlohmann::json(nullptr)}});
+           {"estimated_relative_rms", rms ? nlohmann::json(*rms) : nlohmann::json(nullptr)},
+           {"pixels_without_estimate", sums.unknown}});
       const auto& q = job.request.quality;
       if (job.merger->complete()) {
         stop = "samples";

@@ -95,10 +95,14 @@ void TileMerger::resolve(Image* image) const {
   for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(tile(t));
 }
 
-std::optional<double> TileMerger::estimated_relative_rms(const std::vector<std::uint32_t>& excluded) const {
+ErrorSums TileMerger::error_sums(const std::vector<std::uint32_t>& excluded) const {
   ErrorSums sums;
-  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(error_sums(tile(t), excluded, plan_.width));
-  return sums.relative_rms();
+  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(skyfarm::error_sums(tile(t), excluded, plan_.width));
+  return sums;
+}
+
+std::optional<double> TileMerger::estimated_relative_rms(const std::vector<std::uint32_t>& excluded) const {
+  return error_sums(excluded).relative_rms();
 }
 
 // File: magic, version, units merged (little-endian uint32 each), then the

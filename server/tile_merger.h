@@ -22,6 +22,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/film/error_estimate.h"
 #include "common/film/film_tile.h"
 #include "common/film/image.h"
 #include "common/render/render_plan.h"
@@ -66,6 +67,9 @@ class TileMerger {
   // sqrt(sum_i var(Y_i) / sum_i Y_i^2) over pixels with an estimate, or
   // nullopt; `excluded` are the sun disk's pixels (render/sun_pixels.h).
   std::optional<double> estimated_relative_rms(const std::vector<std::uint32_t>& excluded = {}) const;
+  // The sums behind it, with the count of traced pixels that have too few
+  // samples for an estimate (said, not counted as zero error).
+  ErrorSums error_sums(const std::vector<std::uint32_t>& excluded = {}) const;
 
  private:
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }

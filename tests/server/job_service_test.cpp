@@ -103,6 +103,7 @@ TEST(JobService, ShuffledUnitsGiveTheSameExrBytesAsALocalRender) {
   EXPECT_EQ((*status)["progress"]["samples_per_pixel"], 48);
   EXPECT_EQ((*status)["plan"]["passes"], 3);
   EXPECT_FALSE((*status)["error"]["history"].empty());
+  EXPECT_EQ((*status)["error"]["pixels_without_estimate"], 0) << "every traced pixel has >= 2 samples per batch";
   EXPECT_EQ((*status)["plan"]["batches"], 2);
   const auto image = service.image(submitted.id, ImageFormat::kExr);
   ASSERT_TRUE(image);
