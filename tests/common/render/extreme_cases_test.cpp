@@ -3,6 +3,8 @@
 // NaN/Inf firewall and none cut by the depth cap.
 #include <gtest/gtest.h>
 
+#include "tests/support/sun_specs.h"
+
 #include <cmath>
 
 #include "api/render_request.h"
@@ -14,12 +16,7 @@
 namespace skyfarm {
 namespace {
 
-SunSpec sun_at(double zenith_deg, double azimuth_deg = 90.0) {
-  SunSpec s;
-  s.zenith_deg = zenith_deg;
-  s.azimuth_deg = azimuth_deg;
-  return s;
-}
+SunSpec sun_at(double zenith_deg, double azimuth_deg = 90.0) { return testing::sun_spec(zenith_deg, azimuth_deg); }
 
 glm::dvec3 dir(double zenith_deg, double azimuth_deg) {
   return direction_from_zenith_azimuth(zenith_deg * kDegToRad, azimuth_deg * kDegToRad);

@@ -3,6 +3,8 @@
 // Monte Carlo estimate plus, where stated, a modelling allowance.
 #include <gtest/gtest.h>
 
+#include "tests/support/sun_specs.h"
+
 #include <cmath>
 #include <glm/geometric.hpp>
 
@@ -16,11 +18,7 @@ namespace skyfarm {
 namespace {
 
 SunSpec sun_at(double zenith_deg, double azimuth_deg, double radius_deg = 0.2666) {
-  SunSpec s;
-  s.zenith_deg = zenith_deg;
-  s.azimuth_deg = azimuth_deg;
-  s.angular_radius_deg = radius_deg;
-  return s;
+  return testing::sun_spec(zenith_deg, azimuth_deg, radius_deg);
 }
 
 // --- Transmittance: ratio tracking is unbiased at every wavelength of a path.

@@ -3,17 +3,15 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/support/sun_specs.h"
+
 #include <algorithm>
 
 namespace skyfarm {
 namespace {
 
 Sun sun_at(double zenith, double azimuth, double radius = 0.2666) {
-  SunSpec s;
-  s.zenith_deg = zenith;
-  s.azimuth_deg = azimuth;
-  s.angular_radius_deg = radius;
-  return Sun::from_spec(s, Location{}, std::nullopt);
+  return testing::sun_from_angles(zenith, azimuth, radius);
 }
 
 TEST(SunPixels, EquirectCoversTheDiskPixelAndItsNeighbours) {
