@@ -7,10 +7,16 @@ RenderSetup make_render_setup(const RenderRequest& request) {
   s.scene = std::make_unique<Scene>(Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
                                                       request.spectral.min_nm, request.spectral.max_nm));
   s.camera = std::make_unique<Camera>(request.camera, s.scene->observer());
-  s.plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                            request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
-                            request.seed);
+  s.plan = render_plan_for(request, s.scene->sun());
   return s;
+}
+
+RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
+  constexpr int kTileSize = 32, kSamplesPerPass = 16;
+  return make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                          request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
+                          request.seed, kTileSize, kSamplesPerPass,
+                          mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
 }
 
 }  // namespace skyfarm::api

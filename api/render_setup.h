@@ -21,6 +21,9 @@ struct RenderSetup {
 
 RenderSetup make_render_setup(const RenderRequest& request);
 
+// The plan of a request (tiles, batches, passes, mirror symmetry), given its sun.
+RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun);
+
 // The metadata every rendered image carries (EXR attributes, PNG text), the
 // same for `skyfarm-worker render` and the farm so their files are identical:
 // canonical request, sun position, samples, wavelength range, version,

@@ -83,7 +83,7 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
   }
   return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
-          {"tile_size", plan.tile_size},  {"units", plan.unit_count()}};
+          {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored}};
 }
 
 }  // namespace
@@ -198,14 +198,13 @@ JobService::~JobService() = default;
 
 Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
   auto job = std::make_unique<Job>();
-  job->plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                               request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
-                               request.seed);
+  const Sun sun = Sun::from_spec(request.sun, request.location, request.time);
+  job->plan = api::render_plan_for(request, sun);
   job->plan_json = plan_report(request, job->plan);
   {
     const Camera camera(request.camera,
                         {0.0, 0.0, request.atmosphere.planet_radius_m + request.location.altitude_m});
-    job->sun_pixels = sun_pixels(camera, Sun::from_spec(request.sun, request.location, request.time));
+    job->sun_pixels = sun_pixels(camera, sun);
   }
   job->dir = data_dir / "jobs" / record.id;
   job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
@@ -271,9 +270,7 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
   }
   if (active >= impl_->limits.max_active_jobs)
     throw CapacityExceeded("too many active jobs (" + std::to_string(active) + "); try again later");
-  const RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                                           request.spectral.max_nm, request.spectral.batches,
-                                           request.quality.samples_per_pixel, request.seed);
+  const RenderPlan plan = api::render_plan_for(request, Sun::from_spec(request.sun, request.location, request.time));
   if (queued_units + plan.unit_count() > impl_->limits.max_queue_units)
     throw CapacityExceeded("the queue is full (" + std::to_string(queued_units) + " units waiting); try again later");
 

@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "common/film/error_estimate.h"
+#include "common/film/mirror_image.h"
 #include "common/image/atomic_file.h"
 #include "server/job_service.h"
 
@@ -93,6 +94,7 @@ int TileMerger::complete_passes() const {
 
 void TileMerger::resolve(Image* image) const {
   for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(tile(t));
+  if (plan_.mirrored) mirror_left_half(image);
 }
 
 ErrorSums TileMerger::error_sums(const std::vector<std::uint32_t>& excluded) const {

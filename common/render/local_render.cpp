@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/film/error_estimate.h"
+#include "common/film/mirror_image.h"
 #include "common/render/parallel.h"
 
 namespace skyfarm {
@@ -31,6 +32,7 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
       progress(++done, tiles);
     }
   });
+  if (plan.mirrored) mirror_left_half(image);
   LocalRenderResult r;
   ErrorSums error;
   for (const auto& s : stats) {  // tile order: deterministic
@@ -86,6 +88,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     }
   }
   for (const auto& tile : film) image->resolve(tile);
+  if (plan.mirrored) mirror_left_half(image);
   for (const auto& c : counters) r.counters.add(c);
   return r;
 }

@@ -33,6 +33,11 @@ struct RenderPlan {
   int samples_per_pass = 16;
   int passes = 1;
   std::uint64_t seed = 1;
+  // Mirror symmetry (DESIGN §3.5): when the view is symmetric about the sun's
+  // vertical plane, only columns [0, width / 2) are rendered (tiles cover
+  // them alone) and the right half is their mirror image (mirror_image.h).
+  bool mirrored = false;
+  int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }
   int unit_count() const { return tile_count() * batches * passes; }
@@ -51,6 +56,14 @@ struct RenderPlan {
 };
 
 RenderPlan make_render_plan(int width, int height, double lambda_min_nm, double lambda_max_nm, int batches,
-                            int samples_per_pixel, std::uint64_t seed, int tile_size = 32, int samples_per_pass = 16);
+                            int samples_per_pixel, std::uint64_t seed, int tile_size = 32, int samples_per_pass = 16,
+                            bool mirrored = false);
+
+// Whether an image may be rendered half and mirrored: an equirectangular view
+// with no pitch or roll whose centre column looks along (or against) the
+// sun's azimuth, so the sun's vertical plane is the middle of the image, and
+// a width of whole tile pairs.  The atmosphere is horizontally uniform and the
+// observer on the plane, so the sky is mirror-symmetric about it.
+bool mirror_symmetric(const CameraSpec& camera, double sun_azimuth_deg, int tile_size = 32);
 
 }  // namespace skyfarm

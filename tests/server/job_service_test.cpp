@@ -328,3 +328,36 @@ TEST(JobService, TimeLimitStopsAtTheNextWholePass) {
 
 }  // namespace
 }  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// A mirror-symmetric view (centred on the sun's azimuth): the farm renders
+// half the tiles and its EXR equals the local render's.
+TEST(JobService, MirroredJobRendersHalfAndMatchesTheLocalRender) {
+  constexpr const char* kMirrored = R"({
+    "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "equirectangular", "width": 64, "height": 32, "yaw_deg": 140},
+    "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 32},
+    "output": {"half": false}
+  })";
+  const fs::path dir = fresh_dir("mirror");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kMirrored), std::nullopt).id;
+  const auto before = *service.status(id);
+  EXPECT_EQ(before["plan"]["mirrored"], true);
+  EXPECT_EQ(before["plan"]["tiles"], 1);  // the left 32 columns
+  std::mt19937 rng(6);
+  run_shuffled(service, rng, 4);
+  ASSERT_EQ((*service.status(id))["state"], "done");
+  fs::create_directories(dir / "local");
+  std::ofstream(dir / "local" / "request.json") << kMirrored;
+  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "local" / "request.json").string() +
+                          " -o " + (dir / "local" / "local.exr").string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), read_file(dir / "local" / "local.exr"));
+}
+
+}  // namespace
+}  // namespace skyfarm::server
