@@ -76,9 +76,10 @@ void run_shuffled(JobService& service, std::mt19937& rng, std::size_t batch, int
   }
 }
 
-std::string local_render_exr(const fs::path& dir) {
+// `skyfarm-worker render` of `request` in `dir`; the EXR's bytes ("" on failure).
+std::string local_render_exr(const fs::path& dir, const char* request = kRequest) {
   fs::create_directories(dir);
-  std::ofstream(dir / "request.json") << kRequest;
+  std::ofstream(dir / "request.json") << request;
   const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "request.json").string() +
                           " -o " + (dir / "local.exr").string() + " > /dev/null 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0);
@@ -305,12 +306,7 @@ TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {
   ASSERT_GE(h.size(), 2u);
   EXPECT_GT(h[0]["estimated_relative_rms"].get<double>(), h.back()["estimated_relative_rms"].get<double>());
 
-  fs::create_directories(dir / "local");
-  std::ofstream(dir / "local" / "request.json") << kTargeted;
-  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "local" / "request.json").string() +
-                          " -o " + (dir / "local" / "local.exr").string() + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0);
-  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), read_file(dir / "local" / "local.exr"));
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kTargeted));
 }
 
 TEST(JobService, TimeLimitStopsAtTheNextWholePass) {
@@ -351,12 +347,7 @@ TEST(JobService, MirroredJobRendersHalfAndMatchesTheLocalRender) {
   std::mt19937 rng(6);
   run_shuffled(service, rng, 4);
   ASSERT_EQ((*service.status(id))["state"], "done");
-  fs::create_directories(dir / "local");
-  std::ofstream(dir / "local" / "request.json") << kMirrored;
-  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "local" / "request.json").string() +
-                          " -o " + (dir / "local" / "local.exr").string() + " > /dev/null 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0);
-  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), read_file(dir / "local" / "local.exr"));
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kMirrored));
 }
 
 }  // namespace
