@@ -111,19 +111,25 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
 
   SampledSpectrum L(0.0), beta(1.0), r_u(1.0), r_l(1.0);
   bool mis_with_sun = false;  // the previous vertex sampled the sun (NEE)
-  // Single scattering along the camera ray comes from its own estimator
-  // (sunlit_single_scattering); the delta-tracked path then carries only
-  // light scattered twice or more: no sun at its first medium vertex, and no
-  // sun disk seen right after it.
+  // With the sunlit-segment estimator, the sun's light scattered in the
+  // medium comes from sunlit_single_scattering on every segment of the path
+  // (camera ray and every ray after a vertex), weighted by the path's
+  // throughput; the delta-tracked path only carries the path on, so it
+  // gathers no sun at its medium vertices and does not count the sun disk
+  // seen right after one (that light is the segment estimator's).  Ground
+  // vertices keep their NEE with MIS.
   const bool explicit_single = options_.explicit_single_scattering && scene_.sun_enabled;
-  bool after_first_medium_vertex = false;
+  bool last_vertex_in_medium = false;  // the ray leaves a medium scattering vertex
   MediumPoint mp;
 
   for (int depth = 0;; ++depth) {
     const RayExtent extent = ray_extent(ray, atmosphere);
     bool scattered = false, absorbed = false;
-    if (depth == 0 && explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
-      L += sunlit_single_scattering(ray, extent.t_begin, extent.t_end, lambda, path, phases, sampler, counters);
+    // --- The sun scattered once along this segment, sampled where it is lit.
+    if (explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
+      L += beta * sunlit_single_scattering(ray, extent.t_begin, extent.t_end, lambda, path, phases, sampler,
+                                           counters) *
+           (1.0 / r_u.average());
 
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
@@ -135,7 +141,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
             // The sun gathered here in expectation: P_s times the NEE of the
             // real-scattering branch (throughput and r_u of that branch).
-            if (scene_.sun_enabled && p_scatter > 0.0 && !(explicit_single && depth == 0)) {
+            if (scene_.sun_enabled && p_scatter > 0.0 && !explicit_single) {
               const double pdf = T_maj_seg[0] * mp.sigma_s[0];
               const SampledSpectrum beta_s = beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
               const SampledSpectrum r_u_s = r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
@@ -184,7 +190,6 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
               r_u *= ratio;
               ray = Ray{p, wi};
               scattered = true;
-              after_first_medium_vertex = explicit_single && depth == 0;
               return false;
             }
             // Null collision.
@@ -225,7 +230,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
         ray = Ray{p, wi};
       } else {
         // --- Escaped: the sun disk (with MIS if the last vertex sampled it) and the environment.
-        if (scene_.sun_enabled && sun.contains(ray.d) && !after_first_medium_vertex) {
+        if (scene_.sun_enabled && sun.contains(ray.d) && !(explicit_single && last_vertex_in_medium)) {
           const SampledSpectrum& Le = path.sun_radiance;
           if (!mis_with_sun) {
             L += beta * Le * (1.0 / r_u.average());
@@ -240,8 +245,7 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
       }
     }
     mis_with_sun = scene_.sun_enabled && !sun.is_point();
-    if (!scattered) after_first_medium_vertex = false;  // a ground bounce ends the exclusion
-    else if (depth > 0) after_first_medium_vertex = false;
+    last_vertex_in_medium = scattered;
 
     // --- Russian roulette on the MIS-normalised throughput.
     if (beta.is_zero()) return L;
@@ -333,9 +337,11 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
 //   L_ss = int_sunlit T(o, x_t) sigma_s(x_t) p(theta) T(x_t, sun) L_sun dt.
 // The sunlit part of [t0, t1] is the line minus the planet's shadow cylinder
 // (points x with x.s < 0 and |x - (x.s) s| < R, s towards the sun), at most
-// two intervals found in closed form.  Within them t is drawn proportionally
-// to the hero wavelength's majorant (so mostly at the lowest sunlit
-// altitudes), pdf(t) = sigma_maj(t) / tau_maj(sunlit); the transmittances
+// two intervals found in closed form.  Within them t is drawn from the hero
+// wavelength's majorant as free-flight sampling would, but truncated to the
+// lit intervals (taken end to end):
+//   pdf(t) = sigma_maj(t) exp(-tau_maj(t)) / (1 - exp(-tau_maj(lit))),
+// tau_maj(t) the majorant optical depth of the lit part up to t; the transmittances
 // are unbiased ratio-tracking estimates, the sun direction is sampled on the
 // disk.  When the sun is below the horizon this puts every sample where the
 // light is, instead of waiting for a rare collision high up.
@@ -390,8 +396,14 @@ SampledSpectrum VolumePathIntegrator::sunlit_single_scattering(const Ray& ray, d
   }
   const double u_t = sampler.next(), u_s1 = sampler.next(), u_s2 = sampler.next();
   if (!(tau_lit > 0.0)) return SampledSpectrum(0.0);
-  // Invert: the point where the majorant optical depth reaches u tau_lit.
-  double target = u_t * tau_lit, t = -1.0, sigma_maj0 = 0.0;
+  // Invert: the point where the majorant optical depth reaches tau_star,
+  // drawn from the truncated exponential p(tau) = e^-tau / (1 - e^-tau_lit)
+  // so that long, dense lit segments (the horizon at noon) sample near the
+  // camera, where T(o, x_t) keeps the light, and thin ones (twilight) almost
+  // uniformly in tau, i.e. where the lit air is densest.
+  const double lit_mass = -std::expm1(-tau_lit);
+  const double tau_star = std::min(tau_lit, -std::log1p(-u_t * lit_mass));
+  double target = tau_star, t = -1.0, sigma_maj0 = 0.0;
   for (int k = 0; k < n_lit && t < 0.0; ++k) {
     ShellTraversal walk(ray, R, shells.bottoms, lit[static_cast<std::size_t>(k)].first,
                         lit[static_cast<std::size_t>(k)].second);
@@ -408,7 +420,7 @@ SampledSpectrum VolumePathIntegrator::sunlit_single_scattering(const Ray& ray, d
     }
   }
   if (t < 0.0 || !(sigma_maj0 > 0.0)) return SampledSpectrum(0.0);
-  const double pdf_t = sigma_maj0 / tau_lit;
+  const double pdf_t = sigma_maj0 * std::exp(-tau_star) / lit_mass;
   const glm::dvec3 x = ray.at(t);
   MediumPoint mp;
   medium.point(glm::length(x) - R, path, &mp);
