@@ -24,7 +24,7 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
 namespace skyfarm::api {
 
 void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
-                         int samples_per_pixel, std::optional<double> estimated_relative_rms) {
+                         int samples_per_pixel, const ErrorSums& error) {
   namespace key = metadata_key;
   image->set_metadata(key::kRequest, canonical_text(request));
   image->set_metadata(key::kSunZenithDeg, sun.zenith_deg());
@@ -33,7 +33,12 @@ void set_render_metadata(Image* image, const RenderRequest& request, const Rende
   image->set_metadata(key::kWavelengthMinNm, plan.lambda_min_nm);
   image->set_metadata(key::kWavelengthMaxNm, plan.lambda_max_nm);
   image->set_metadata(key::kSoftwareVersion, std::string("skyfarm ") + SKYFARM_VERSION);
-  if (estimated_relative_rms) image->set_metadata(key::kEstimatedRelativeRms, *estimated_relative_rms);
+  if (const auto e = error.relative_rms()) image->set_metadata(key::kEstimatedRelativeRms, *e);
+  if (const auto e = error.relative_rms_rgb()) {
+    image->set_metadata(key::kEstimatedRelativeRmsR, e->r);
+    image->set_metadata(key::kEstimatedRelativeRmsG, e->g);
+    image->set_metadata(key::kEstimatedRelativeRmsB, e->b);
+  }
   image->set_metadata("method", std::string("path"));
   image->set_metadata("earth_sun_distance_au", sun.distance_au());
 }

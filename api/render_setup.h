@@ -7,6 +7,7 @@
 
 #include "api/render_request.h"
 #include "common/camera/camera.h"
+#include "common/film/error_estimate.h"
 #include "common/film/image.h"
 #include "common/render/render_plan.h"
 #include "common/render/scene.h"
@@ -29,6 +30,6 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun);
 // canonical request, sun position, samples, wavelength range, version,
 // method and the estimated error.
 void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
-                         int samples_per_pixel, std::optional<double> estimated_relative_rms);
+                         int samples_per_pixel, const ErrorSums& error);
 
 }  // namespace skyfarm::api

@@ -300,9 +300,10 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
   nlohmann::json workers_json = nlohmann::json::array();
   for (const auto& [id, n] : job.worker_units) workers_json.push_back({{"id", id}, {"units", n}});
   const std::string self = "/v1/renders/" + job.record.id;
-  nlohmann::json estimate = nullptr, unknown = nullptr;
+  nlohmann::json estimate = nullptr, estimate_rgb = nullptr, unknown = nullptr;
   if (!job.history.empty()) {
     estimate = job.history.back()["estimated_relative_rms"];
+    estimate_rgb = job.history.back().value("estimated_relative_rms_rgb", nlohmann::json(nullptr));
     unknown = job.history.back()["pixels_without_estimate"];
   }
   return {{"id", job.record.id},
@@ -314,6 +315,7 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
           {"eta_s", eta},
           {"error",
            {{"estimated_relative_rms", estimate},
+            {"estimated_relative_rms_rgb", estimate_rgb},
             {"pixels_without_estimate", unknown},
             {"sun_pixels_excluded", job.sun_pixels.size()},
             {"history", job.history}}},
@@ -392,7 +394,7 @@ void JobService::Impl::write_images(Job& job, bool final) {
   api::set_render_metadata(&image, job.request, job.plan, sun,
                            std::min(job.plan.samples_per_pixel,
                                     job.merger->complete_passes() * job.plan.samples_per_pass),
-                           job.merger->estimated_relative_rms(job.sun_pixels));
+                           job.merger->error_sums(job.sun_pixels));
   try {
     ExrWriteOptions exr;
     exr.half = out.half;
@@ -596,10 +598,13 @@ void JobService::Impl::finish_if_complete(Job& job) {
       job.passes_reported = passes;
       const ErrorSums sums = job.merger->error_sums(job.sun_pixels);
       const auto rms = sums.relative_rms();
+      const auto rms_rgb = sums.relative_rms_rgb();
       job.history.push_back(
           {{"elapsed_s", job.elapsed_s()},
            {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
            {"estimated_relative_rms", rms ? nlohmann::json(*rms) : nlohmann::json(nullptr)},
+           {"estimated_relative_rms_rgb", rms_rgb ? nlohmann::json{{"r", rms_rgb->r}, {"g", rms_rgb->g}, {"b", rms_rgb->b}}
+                                                  : nlohmann::json(nullptr)},
            {"pixels_without_estimate", sums.unknown}});
       const auto& q = job.request.quality;
       if (job.merger->complete()) {

@@ -100,7 +100,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   }
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  api::set_render_metadata(&image, request, plan, scene.sun(), samples, result.estimate);
+  api::set_render_metadata(&image, request, plan, scene.sun(), samples, result.error);
 
   ExrWriteOptions exr;
   exr.half = request.output.half;
@@ -121,10 +121,11 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
     std::printf("wrote %s (exposure EV100 %.2f)\n", png_path.c_str(), r.exposure_ev);
   }
   const double paths = static_cast<double>(result.counters.paths);
-  std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f, "
-              "%d samples per pixel, stopped by %s\n",
+  const Rgb e_rgb = result.error.relative_rms_rgb().value_or(Rgb{0.0, 0.0, 0.0});
+  std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f "
+              "(R %.4f, G %.4f, B %.4f), %d samples per pixel, stopped by %s\n",
               seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(threads),
-              result.estimated_relative_rms, samples, stopped_by.c_str());
+              result.estimated_relative_rms, e_rgb.r, e_rgb.g, e_rgb.b, samples, stopped_by.c_str());
   if (result.counters.nonfinite > 0)
     std::printf("warning: %llu non-finite or negative path results were discarded\n",
                 static_cast<unsigned long long>(result.counters.nonfinite));

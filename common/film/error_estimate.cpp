@@ -10,6 +10,12 @@ std::optional<double> ErrorSums::relative_rms() const {
   return std::sqrt(sum_var / sum_Y2);
 }
 
+std::optional<Rgb> ErrorSums::relative_rms_rgb() const {
+  if (!(sum_rgb2.r > 0.0) || !(sum_rgb2.g > 0.0) || !(sum_rgb2.b > 0.0)) return std::nullopt;
+  return Rgb{std::sqrt(sum_var_rgb.r / sum_rgb2.r), std::sqrt(sum_var_rgb.g / sum_rgb2.g),
+             std::sqrt(sum_var_rgb.b / sum_rgb2.b)};
+}
+
 ErrorSums error_sums(const FilmTile& tile, const std::vector<std::uint32_t>& excluded, int image_width) {
   ErrorSums s;
   for (int y = tile.y0(); y < tile.y0() + tile.height(); ++y)
@@ -28,6 +34,10 @@ ErrorSums error_sums(const FilmTile& tile, const std::vector<std::uint32_t>& exc
       }
       s.sum_var += *var;
       s.sum_Y2 += mean->y * mean->y;
+      const Rgb var_rgb = *tile.rgb_variance_of_mean(x, y);  // known: the luminance's is
+      const Rgb rgb = xyz_to_linear_srgb(*mean);
+      s.sum_var_rgb = Rgb{s.sum_var_rgb.r + var_rgb.r, s.sum_var_rgb.g + var_rgb.g, s.sum_var_rgb.b + var_rgb.b};
+      s.sum_rgb2 = Rgb{s.sum_rgb2.r + rgb.r * rgb.r, s.sum_rgb2.g + rgb.g * rgb.g, s.sum_rgb2.b + rgb.b * rgb.b};
     }
   return s;
 }

@@ -12,8 +12,8 @@ namespace skyfarm {
 
 namespace {
 
-static_assert(sizeof(PixelBatchSums) == 6 * sizeof(double), "PixelBatchSums must be six packed doubles");
-constexpr std::size_t kDoublesPerRecord = 6;
+static_assert(sizeof(PixelBatchSums) == 9 * sizeof(double), "PixelBatchSums must be nine packed doubles");
+constexpr std::size_t kDoublesPerRecord = 9;
 constexpr std::size_t kHeaderBytes = 40;  // up to the presence flags
 constexpr std::size_t kCrcBytes = 4;
 constexpr char kMagic[4] = {'S', 'K', 'F', 'T'};
@@ -61,10 +61,11 @@ bool is_finite_sample(const Xyz& c, double l) {
 
 // s² = (ΣY² − (ΣY)²/n) / (n − 1), the unbiased sample variance from raw sums
 // (clamped at 0 against rounding); n ≥ 2.
-double sample_variance(const PixelBatchSums& s) {
-  const double m2 = s.sum_y2 - s.sum_y * s.sum_y / s.n;
-  return std::max(0.0, m2 / (s.n - 1.0));
+double sample_variance(double n, double sum, double sum_sq) {
+  const double m2 = sum_sq - sum * sum / n;
+  return std::max(0.0, m2 / (n - 1.0));
 }
+double sample_variance(const PixelBatchSums& s) { return sample_variance(s.n, s.sum_y, s.sum_y2); }
 
 [[noreturn]] void decode_error(const std::string& what) {
   throw FilmTileDecodeError("FilmTile::deserialize: " + what);
@@ -102,7 +103,10 @@ std::size_t FilmTile::index(int x, int y, int batch) const {
 
 void FilmTile::add_sample(int x, int y, int batch, const Xyz& xyz, double band_radiance) {
   PixelBatchSums& s = data_[index(x, y, batch)];
-  if (!is_finite_sample(xyz, band_radiance)) {
+  const Rgb rgb = xyz_to_linear_srgb(xyz);
+  const double r2 = rgb.r * rgb.r, g2 = rgb.g * rgb.g, b2 = rgb.b * rgb.b, y2 = xyz.y * xyz.y;
+  // A square that overflows would poison the pixel's sums just like a NaN.
+  if (!is_finite_sample(xyz, band_radiance) || !std::isfinite(r2 + g2 + b2 + y2)) {
     ++rejected_;
     return;
   }
@@ -110,8 +114,11 @@ void FilmTile::add_sample(int x, int y, int batch, const Xyz& xyz, double band_r
   s.sum_x += xyz.x;
   s.sum_y += xyz.y;
   s.sum_z += xyz.z;
-  s.sum_y2 += xyz.y * xyz.y;
+  s.sum_y2 += y2;
   s.sum_l += band_radiance;
+  s.sum_r2 += r2;
+  s.sum_g2 += g2;
+  s.sum_b2 += b2;
 }
 
 void FilmTile::merge(const FilmTile& other) {
@@ -131,6 +138,9 @@ void FilmTile::merge(const FilmTile& other) {
     a.sum_z += b.sum_z;
     a.sum_y2 += b.sum_y2;
     a.sum_l += b.sum_l;
+    a.sum_r2 += b.sum_r2;
+    a.sum_g2 += b.sum_g2;
+    a.sum_b2 += b.sum_b2;
   }
   rejected_ += other.rejected_;
 }
@@ -197,6 +207,20 @@ std::optional<double> FilmTile::relative_standard_error(int x, int y) const {
   return std::sqrt(*var) / mean;
 }
 
+std::optional<Rgb> FilmTile::rgb_variance_of_mean(int x, int y) const {
+  (void)index(x, y, 0);  // range check
+  Rgb var{0.0, 0.0, 0.0};
+  for (int b = 0; b < batches_; ++b) {
+    const PixelBatchSums& s = data_[unchecked_index(x, y, b)];
+    if (s.n < 2.0) return std::nullopt;
+    const Rgb sum = xyz_to_linear_srgb(Xyz{s.sum_x, s.sum_y, s.sum_z});
+    var.r += sample_variance(s.n, sum.r, s.sum_r2) / s.n;
+    var.g += sample_variance(s.n, sum.g, s.sum_g2) / s.n;
+    var.b += sample_variance(s.n, sum.b, s.sum_b2) / s.n;
+  }
+  return var;
+}
+
 std::vector<std::uint8_t> FilmTile::serialize() const {
   const std::size_t per_batch = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
   std::vector<std::uint8_t> present(static_cast<std::size_t>(batches_), 0);
@@ -207,7 +231,9 @@ std::vector<std::uint8_t> FilmTile::serialize() const {
     const bool nonzero = std::any_of(first, first + per_batch, [](const PixelBatchSums& s) {
       return std::bit_cast<std::uint64_t>(s.n) | std::bit_cast<std::uint64_t>(s.sum_x) |
              std::bit_cast<std::uint64_t>(s.sum_y) | std::bit_cast<std::uint64_t>(s.sum_z) |
-             std::bit_cast<std::uint64_t>(s.sum_y2) | std::bit_cast<std::uint64_t>(s.sum_l);
+             std::bit_cast<std::uint64_t>(s.sum_y2) | std::bit_cast<std::uint64_t>(s.sum_l) |
+             std::bit_cast<std::uint64_t>(s.sum_r2) | std::bit_cast<std::uint64_t>(s.sum_g2) |
+             std::bit_cast<std::uint64_t>(s.sum_b2);
     });
     if (nonzero) {
       present[static_cast<std::size_t>(b)] = 1;
@@ -234,7 +260,7 @@ std::vector<std::uint8_t> FilmTile::serialize() const {
     const PixelBatchSums* first = data_.data() + static_cast<std::size_t>(b) * per_batch;
     for (std::size_t i = 0; i < per_batch; ++i) {
       const PixelBatchSums& s = first[i];
-      for (double v : {s.n, s.sum_x, s.sum_y, s.sum_z, s.sum_y2, s.sum_l}) {
+      for (double v : {s.n, s.sum_x, s.sum_y, s.sum_z, s.sum_y2, s.sum_l, s.sum_r2, s.sum_g2, s.sum_b2}) {
         store_u64(p, std::bit_cast<std::uint64_t>(v));
         p += 8;
       }
@@ -267,7 +293,7 @@ FilmTile FilmTile::deserialize(const std::uint8_t* bytes, std::size_t size) {
                  std::to_string(w) + " x " + std::to_string(h) + " x " + std::to_string(nb) + " batches");
   if (n_present > nb) decode_error("corrupt header: " + std::to_string(n_present) + " present batches of " +
                                    std::to_string(nb));
-  // Sizes are bounded by the limits above (2^16 · 2^16 · 4096 · 48 < 2^63).
+  // Sizes are bounded by the limits above (2^16 · 2^16 · 4096 · 72 < 2^63).
   const std::uint64_t per_batch_bytes = static_cast<std::uint64_t>(w) * h * kDoublesPerRecord * 8;
   const std::uint64_t expected = kHeaderBytes + nb + n_present * per_batch_bytes + kCrcBytes;
   if (size != expected)
@@ -298,9 +324,9 @@ FilmTile FilmTile::deserialize(const std::uint8_t* bytes, std::size_t size) {
       for (std::size_t k = 0; k < kDoublesPerRecord; ++k, p += 8) v[k] = std::bit_cast<double>(get_u64(p));
       for (double d : v)
         if (!std::isfinite(d)) decode_error("non-finite sum in batch " + std::to_string(b));
-      if (v[0] < 0.0 || v[4] < 0.0)
+      if (v[0] < 0.0 || v[4] < 0.0 || v[6] < 0.0 || v[7] < 0.0 || v[8] < 0.0)
         decode_error("negative sample count or sum of squares in batch " + std::to_string(b));
-      first[i] = PixelBatchSums{v[0], v[1], v[2], v[3], v[4], v[5]};
+      first[i] = PixelBatchSums{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], v[8]};
     }
   }
   return tile;

@@ -10,7 +10,7 @@
 //   batches    B, the number of equal wavelength batches the spectral range
 //              is cut into (wavelength_sampling.h, batch_range; ≥ 1)
 //
-// Per pixel and batch b the tile holds six doubles (PixelBatchSums):
+// Per pixel and batch b the tile holds nine doubles (PixelBatchSums):
 //   n       the number of samples added,
 //   sum_x, sum_y, sum_z
 //           ΣX, ΣY, ΣZ of the per-sample absolute tristimulus estimates
@@ -18,7 +18,11 @@
 //           drawn inside batch b with the batch's own pdf),
 //   sum_y2  ΣY², for the sample variance of the luminance,
 //   sum_l   ΣL, the per-sample estimates of the band's mean spectral radiance
-//           (1/Δλ_b) ∫_{batch b} L(λ) dλ, W m⁻² sr⁻¹ nm⁻¹ (spectral channels).
+//           (1/Δλ_b) ∫_{batch b} L(λ) dλ, W m⁻² sr⁻¹ nm⁻¹ (spectral channels),
+//   sum_r2, sum_g2, sum_b2
+//           ΣR², ΣG², ΣB² of the per-sample linear sRGB (Rec. 709) values
+//           xyz_to_linear_srgb(X, Y, Z), for the per-channel variances (ΣR
+//           itself is the same linear map of ΣX, ΣY, ΣZ, so it is not stored).
 //
 // Statistics (per pixel; batches are independent estimates of disjoint parts
 // of ∫ over the whole range, so the whole-range estimate is their SUM):
@@ -26,6 +30,7 @@
 //   variance of Ȳ       Var[Ȳ] = Σ_b s²_b / n_b,
 //                       s²_b = (ΣY²_b − (ΣY_b)²/n_b) / (n_b − 1)   (unbiased; needs n_b ≥ 2 ∀b)
 //   relative std error  sqrt(Var[Ȳ]) / Ȳ
+//   variance of R̄ (G, B) Σ_b s²_R,b / n_b likewise, from ΣR² and ΣR = M ΣXYZ
 // A pixel without enough samples in some batch has NO estimate: the accessors
 // return std::nullopt ("unknown"), never a silent 0 or a NaN.  s²_b is
 // computed from the raw sums (the form that merges by addition); rounding can
@@ -44,7 +49,7 @@
 // Wire format (serialize / deserialize; all integers and doubles little-endian,
 // independent of the host):
 //   offset 0   4 bytes   magic "SKFT"
-//          4   u32       format version (kFormatVersion = 1)
+//          4   u32       format version (kFormatVersion = 2)
 //          8   i32 x0,  12 i32 y0,  16 u32 width,  20 u32 height
 //         24   u32       batches B
 //         28   u32       P, the number of batches present (see below)
@@ -53,7 +58,7 @@
 //                        0 = the batch is all zeros and omitted (a unit of
 //                        work fills one batch only, so its frame carries one)
 //       then   for each present batch in order: width × height records of
-//              6 f64 (n, ΣX, ΣY, ΣZ, ΣY², ΣL), row by row
+//              9 f64 (n, ΣX, ΣY, ΣZ, ΣY², ΣL, ΣR², ΣG², ΣB²), row by row
 //       last   u32       CRC-32 (IEEE 802.3, as zlib's crc32) of all bytes before it
 // deserialize rejects anything else (wrong size, magic, version, flags, CRC,
 // negative counts, non-finite sums) with FilmTileDecodeError.
@@ -71,7 +76,7 @@
 
 namespace skyfarm {
 
-// The six running sums of one pixel in one batch (see the file comment).
+// The nine running sums of one pixel in one batch (see the file comment).
 struct PixelBatchSums {
   double n = 0.0;
   double sum_x = 0.0;
@@ -79,6 +84,9 @@ struct PixelBatchSums {
   double sum_z = 0.0;
   double sum_y2 = 0.0;
   double sum_l = 0.0;
+  double sum_r2 = 0.0;
+  double sum_g2 = 0.0;
+  double sum_b2 = 0.0;
 };
 
 // A serialized tile that cannot be decoded (truncated, corrupt, wrong version).
@@ -89,7 +97,7 @@ class FilmTileDecodeError : public std::runtime_error {
 
 class FilmTile {
  public:
-  static constexpr std::uint32_t kFormatVersion = 1;
+  static constexpr std::uint32_t kFormatVersion = 2;
   // Limits on a tile's geometry (a tile is a part of an image, and a frame
   // that claims more is corrupt).
   static constexpr int kMaxDimension = 1 << 16;
@@ -114,7 +122,7 @@ class FilmTile {
   }
 
   // Adds one sample to pixel (x, y) (image coordinates) of batch b: n += 1,
-  // ΣX += xyz.x, …, ΣY² += xyz.y², ΣL += band_radiance.  A sample with a
+  // ΣX += xyz.x, …, ΣY² += xyz.y², ΣL += band_radiance, ΣR² += R², ….  A sample with a
   // non-finite value is counted in rejected_samples() and not added.
   // Throws std::out_of_range for a pixel outside the tile or a bad batch.
   void add_sample(int x, int y, int batch, const Xyz& xyz, double band_radiance);
@@ -155,6 +163,9 @@ class FilmTile {
   // pixel); nullopt when Ȳ ≤ 0 with a positive variance (no meaningful
   // relative error).
   std::optional<double> relative_standard_error(int x, int y) const;
+  // Variances of the whole-range mean linear sRGB channels (R̄, Ḡ, B̄),
+  // Σ_b s²_b / n_b per channel; nullopt unless every batch has n_b ≥ 2.
+  std::optional<Rgb> rgb_variance_of_mean(int x, int y) const;
 
   // --- Wire format ----------------------------------------------------------
   std::vector<std::uint8_t> serialize() const;

@@ -68,6 +68,10 @@ inline constexpr const char kWavelengthMinNm[] = "wavelength_min_nm";
 inline constexpr const char kWavelengthMaxNm[] = "wavelength_max_nm";
 inline constexpr const char kSoftwareVersion[] = "software_version";
 inline constexpr const char kEstimatedRelativeRms[] = "estimated_relative_rms";
+// Per linear sRGB channel (error_estimate.h).
+inline constexpr const char kEstimatedRelativeRmsR[] = "estimated_relative_rms_r";
+inline constexpr const char kEstimatedRelativeRmsG[] = "estimated_relative_rms_g";
+inline constexpr const char kEstimatedRelativeRmsB[] = "estimated_relative_rms_b";
 }  // namespace metadata_key
 
 class Image {

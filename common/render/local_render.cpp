@@ -42,6 +42,7 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
   r.pixels_without_estimate = error.unknown;
   r.estimate = error.relative_rms();
   r.estimated_relative_rms = r.estimate.value_or(0.0);
+  r.error = error;
   return r;
 }
 
@@ -74,6 +75,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     r.estimate = error.relative_rms();
     r.estimated_relative_rms = r.estimate.value_or(0.0);
     r.pixels_without_estimate = error.unknown;
+    r.error = error;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.history.emplace_back(elapsed, r.estimated_relative_rms);
     if (stop.after_pass) stop.after_pass(p + 1, film, elapsed);

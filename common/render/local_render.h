@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "common/film/error_estimate.h"
 #include "common/film/image.h"
 #include "common/render/tile_renderer.h"
 
@@ -24,6 +25,7 @@ struct LocalRenderResult {
   double estimated_relative_rms = 0.0;  // NaN-free; 0 when nothing has an estimate
   std::optional<double> estimate;       // the same, nullopt when nothing has an estimate
   int pixels_without_estimate = 0;      // fewer than 2 samples in some batch
+  ErrorSums error;                      // all of it, per channel too (error_estimate.h)
 };
 
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,

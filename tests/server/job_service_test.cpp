@@ -305,6 +305,16 @@ TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {
   const auto& h = s["error"]["history"];
   ASSERT_GE(h.size(), 2u);
   EXPECT_GT(h[0]["estimated_relative_rms"].get<double>(), h.back()["estimated_relative_rms"].get<double>());
+  // Per linear sRGB channel too, in the status and in every history entry:
+  // each falls with the passes and stays of the luminance's order.
+  const auto& rgb = s["error"]["estimated_relative_rms_rgb"];
+  ASSERT_TRUE(rgb.is_object()) << rgb.dump();
+  for (const char* c : {"r", "g", "b"}) {
+    SCOPED_TRACE(c);
+    EXPECT_GT(rgb[c].get<double>(), 0.0);
+    EXPECT_LT(rgb[c].get<double>(), 3.0 * s["error"]["estimated_relative_rms"].get<double>());
+    EXPECT_GT(h[0]["estimated_relative_rms_rgb"][c].get<double>(), h.back()["estimated_relative_rms_rgb"][c].get<double>());
+  }
 
   EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kTargeted));
 }

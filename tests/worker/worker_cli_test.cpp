@@ -76,6 +76,13 @@ TEST(WorkerCli, RenderWritesExrAndPngWithMetadata) {
   EXPECT_EQ(exr.channels.count(spectral_channel_name(477.5)), 1u);  // band centre of 360-595 nm
   EXPECT_TRUE(exr.chromaticities.has_value());
   EXPECT_EQ(exr.string_attributes.count("skyfarm:request"), 1u);
+  // The error estimate, of the luminance and per channel, is in the header.
+  for (const char* key : {"skyfarm:estimated_relative_rms", "skyfarm:estimated_relative_rms_r",
+                          "skyfarm:estimated_relative_rms_g", "skyfarm:estimated_relative_rms_b"}) {
+    ASSERT_EQ(exr.number_attributes.count(key), 1u) << key;
+    EXPECT_GT(exr.number_attributes.at(key), 0.0) << key;
+  }
+  EXPECT_NE(r.out.find("(R "), std::string::npos) << r.out;
   // Linear Rec.709 may be negative for colours outside its gamut; the
   // luminance (Rec.709 Y weights) may not.
   double luminance_sum = 0.0;

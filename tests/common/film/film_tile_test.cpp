@@ -33,7 +33,7 @@ FilmTile random_tile(std::uint32_t seed, int samples_per_pixel = 3) {
   return t;
 }
 
-TEST(FilmTile, AddSampleAccumulatesTheSixSums) {
+TEST(FilmTile, AddSampleAccumulatesTheNineSums) {
   FilmTile t(10, 20, 2, 2, 2);
   t.add_sample(11, 21, 1, Xyz{1.0, 2.0, 3.0}, 0.5);
   t.add_sample(11, 21, 1, Xyz{4.0, 5.0, 6.0}, 0.25);
@@ -44,6 +44,10 @@ TEST(FilmTile, AddSampleAccumulatesTheSixSums) {
   EXPECT_EQ(s.sum_z, 9.0);
   EXPECT_EQ(s.sum_y2, 29.0);
   EXPECT_EQ(s.sum_l, 0.75);
+  const Rgb a = xyz_to_linear_srgb(Xyz{1.0, 2.0, 3.0}), b = xyz_to_linear_srgb(Xyz{4.0, 5.0, 6.0});
+  EXPECT_DOUBLE_EQ(s.sum_r2, a.r * a.r + b.r * b.r);
+  EXPECT_DOUBLE_EQ(s.sum_g2, a.g * a.g + b.g * b.g);
+  EXPECT_DOUBLE_EQ(s.sum_b2, a.b * a.b + b.b * b.b);
   EXPECT_EQ(t.sums(11, 21, 0).n, 0.0);  // the other batch is untouched
   EXPECT_EQ(t.sums(10, 20, 1).n, 0.0);  // and so is the other pixel
   EXPECT_EQ(t.total_samples(), 2.0);
@@ -98,6 +102,30 @@ TEST(FilmTile, MeanAndStandardErrorSumOverBatches) {
   EXPECT_DOUBLE_EQ(*t.luminance_variance_of_mean(0, 0), var);
   EXPECT_DOUBLE_EQ(*t.relative_standard_error(0, 0), std::sqrt(var) / 22.0);
   EXPECT_EQ(t.min_batch_samples(0, 0), 2.0);
+}
+
+// Per-channel variance: samples whose linear sRGB is known exactly (built
+// from RGB), so the expected variance is the textbook one per channel:
+// batch 0 R = 1, 3 (s² = 2), G = 2, 2 (0), B = 0, 4 (8);
+// batch 1 R = 10, 20, 30 (s² = 100), G = 1, 1, 1 (0), B = 5, 5, 8 (3).
+TEST(FilmTile, RgbVarianceOfTheMeanPerChannel) {
+  FilmTile t(0, 0, 1, 1, 2);
+  auto add = [&](int b, double r, double g, double bl) {
+    t.add_sample(0, 0, b, linear_srgb_to_xyz(Rgb{r, g, bl}), 0.0);
+  };
+  add(0, 1, 2, 0);
+  EXPECT_FALSE(t.rgb_variance_of_mean(0, 0).has_value());  // n < 2 everywhere: unknown
+  add(0, 3, 2, 4);
+  add(1, 10, 1, 5);
+  add(1, 20, 1, 5);
+  EXPECT_TRUE(t.rgb_variance_of_mean(0, 0).has_value());
+  add(1, 30, 1, 8);
+  const auto var = t.rgb_variance_of_mean(0, 0);
+  ASSERT_TRUE(var.has_value());
+  // Round trips through XYZ cost a few ulps of the squares (values ~1e3).
+  EXPECT_NEAR(var->r, 2.0 / 2.0 + 100.0 / 3.0, 1e-9);
+  EXPECT_NEAR(var->g, 0.0, 1e-9);
+  EXPECT_NEAR(var->b, 8.0 / 2.0 + 3.0 / 3.0, 1e-9);
 }
 
 TEST(FilmTile, TooFewSamplesIsUnknownNotZero) {
@@ -198,7 +226,7 @@ TEST(FilmTile, MergeRejectsADifferentGeometry) {
 TEST(FilmTile, SerializeRoundTripsBitExactly) {
   FilmTile t = random_tile(7);
   // Awkward values: −0, a subnormal, a huge sum, an exact integer count.
-  t.add_sample(16, 8, 0, Xyz{-0.0, 4.9e-324, 1e300}, -0.0);
+  t.add_sample(16, 8, 0, Xyz{-0.0, 4.9e-324, 1e150}, -0.0);
   t.add_sample(17, 8, 0, Xyz{std::numeric_limits<double>::infinity(), 0, 0}, 0);  // rejected, counted
   const std::vector<std::uint8_t> bytes = t.serialize();
   const FilmTile r = FilmTile::deserialize(bytes);
@@ -229,8 +257,8 @@ TEST(FilmTile, SerializedHeaderIsLittleEndianAndOmitsEmptyBatches) {
   EXPECT_EQ(bytes[28], 1);  // one present batch
   EXPECT_EQ(bytes[40 + 0], 0);
   EXPECT_EQ(bytes[40 + 2], 1);
-  // 40-byte header, 4 flags, one batch of 2 × 2 records of 6 doubles, CRC.
-  EXPECT_EQ(bytes.size(), 40u + 4u + 2u * 2u * 6u * 8u + 4u);
+  // 40-byte header, 4 flags, one batch of 2 × 2 records of 9 doubles, CRC.
+  EXPECT_EQ(bytes.size(), 40u + 4u + 2u * 2u * 9u * 8u + 4u);
   const FilmTile r = FilmTile::deserialize(bytes);
   EXPECT_EQ(r.sums(0x0102, 3, 2).sum_z, 3.0);
   EXPECT_EQ(r.sums(0x0103, 4, 0).n, 0.0);
