@@ -42,13 +42,18 @@ std::string request_json(const Scene_& s, int spp, int seed) {
          std::to_string(seed) + "}";
 }
 
-// Luminance per pixel of a film (0 where never traced).
-std::vector<double> luminance_of(const std::vector<FilmTile>& film, int width, int height) {
+// Luminance per pixel of a film (0 where never traced); a mirrored plan's
+// right half is its left half reflected, as in the images.
+std::vector<double> luminance_of(const std::vector<FilmTile>& film, int width, int height, bool mirrored) {
   std::vector<double> Y(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), 0.0);
+  auto at = [&](int x, int y) -> double& { return Y[static_cast<std::size_t>(y * width + x)]; };
   for (const auto& tile : film)
     for (int y = tile.y0(); y < tile.y0() + tile.height(); ++y)
       for (int x = tile.x0(); x < tile.x0() + tile.width(); ++x)
-        if (const auto m = tile.mean_xyz(x, y)) Y[static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x)] = m->y;
+        if (const auto m = tile.mean_xyz(x, y)) at(x, y) = m->y;
+  if (mirrored)
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width / 2; ++x) at(width - 1 - x, y) = at(x, y);
   return Y;
 }
 
@@ -105,7 +110,7 @@ std::vector<double> reference(const Scene_& s, int passes, const fs::path& dir) 
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   StopCriteria stop;
   stop.after_pass = [&](int pass, const std::vector<FilmTile>& film, double) {
-    if (pass == setup.plan.passes) Y = luminance_of(film, 64, 32);
+    if (pass == setup.plan.passes) Y = luminance_of(film, 64, 32, setup.plan.mirrored);
   };
   Image image(64, 32);
   render_image_progressive(renderer, &image, 0, stop);
@@ -202,7 +207,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     StopCriteria stop;
     stop.after_pass = [&](int pass, const std::vector<FilmTile>& film, double elapsed) {
       const double est = estimated_error(film, keep);
-      const double truth = true_error(luminance_of(film, 64, 32), ref, keep);
+      const double truth = true_error(luminance_of(film, 64, 32, setup.plan.mirrored), ref, keep);
       times.push_back(elapsed);
       truths.push_back(truth);
       estimates.push_back(est);
