@@ -15,6 +15,7 @@
 #include "common/render/local_render.h"
 #include "common/render/parallel.h"
 #include "worker/bench_convergence.h"
+#include "worker/bench_efficiency.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
 
@@ -115,11 +116,15 @@ int run_bench_command(const std::vector<std::string>& args) {
       repeat = std::max(1, std::atoi(args[++i].c_str()));
     } else if (args[i] == "convergence") {
       return run_bench_convergence(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
+    } else if (args[i] == "efficiency") {
+      return run_bench_efficiency(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "paths" || args[i] == "demo" || args[i] == "memory" || args[i] == "all") {
       which = args[i];
     } else {
       std::cerr << "usage: skyfarm-worker bench [paths|demo|memory|all] [--repeat N]\n"
-                   "       skyfarm-worker bench convergence [--out DIR] [--passes N]\n";
+                   "       skyfarm-worker bench convergence [--out DIR] [--passes N]\n"
+                   "       skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] [--shadow-scale S] "
+                   "[--sunlit-segments]\n";
       return 2;
     }
   }

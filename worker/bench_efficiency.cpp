@@ -1,0 +1,106 @@
+#include "worker/bench_efficiency.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <optional>
+
+#include <nlohmann/json.hpp>
+
+#include "common/core/constants.h"
+#include "common/render/scene.h"
+#include "common/render/volume_path_integrator.h"
+
+namespace skyfarm {
+namespace {
+
+struct EfficiencyResult {
+  double relative_std_per_path = 0.0;
+  double microseconds_per_path = 0.0;
+  PathCounters counters;
+};
+
+// Unit vector of (zenith, azimuth) in the observer frame (z up, y north, x east).
+glm::dvec3 direction(double zenith_deg, double azimuth_deg) {
+  const double z = zenith_deg * kPi / 180.0, a = azimuth_deg * kPi / 180.0;
+  return {std::sin(z) * std::sin(a), std::sin(z) * std::cos(a), std::cos(z)};
+}
+
+EfficiencyResult measure(double sun_zenith_deg, int samples, const IntegratorOptions& options) {
+  SunSpec sun;
+  sun.zenith_deg = sun_zenith_deg;
+  sun.azimuth_deg = 180.0;
+  const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun, Location{}, std::nullopt, 360.0, 830.0);
+  const VolumePathIntegrator integrator(scene, options);
+  SampledWavelengths wl;
+  wl.lambda_nm.fill(550.0);
+  wl.pdf.fill(1.0);
+  EfficiencyResult r;
+  double sum_w_var = 0.0, sum_w_L2 = 0.0, sum_w_seconds = 0.0, sum_w = 0.0;
+  std::uint64_t pixel = 0;
+  for (double zen = 2.5; zen < 180.0; zen += 5.0)
+    for (double az = 7.5; az < 360.0; az += 15.0, ++pixel) {
+      if (std::abs(zen - sun_zenith_deg) < 4.0 && std::abs(az - 180.0) < 10.0) continue;  // the disk
+      const double w = std::sin(zen * kPi / 180.0);
+      const Ray ray{scene.observer(), direction(zen, az)};
+      double sum = 0.0, sum_sq = 0.0;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int i = 0; i < samples; ++i) {
+        Sampler sampler(7, pixel, static_cast<std::uint64_t>(i));
+        const double L = integrator.radiance(ray, wl, sampler, &r.counters)[0];
+        sum += L;
+        sum_sq += L * L;
+      }
+      sum_w_seconds += w * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double mean = sum / samples, var = std::max(0.0, sum_sq / samples - mean * mean);
+      sum_w_var += w * var;
+      sum_w_L2 += w * mean * mean;
+      sum_w += w;
+    }
+  r.relative_std_per_path = sum_w_L2 > 0.0 ? std::sqrt(sum_w_var / sum_w_L2) : 0.0;
+  r.microseconds_per_path = sum_w_seconds / sum_w / samples * 1e6;
+  return r;
+}
+
+}  // namespace
+
+int run_bench_efficiency(const std::vector<std::string>& args) {
+  int samples = 1000;
+  std::vector<double> suns;
+  IntegratorOptions options;
+  for (std::size_t i = 1; i < args.size(); ++i) {  // args[0] is "efficiency"
+    if (args[i] == "--samples" && i + 1 < args.size()) {
+      samples = std::max(2, std::atoi(args[++i].c_str()));
+    } else if (args[i] == "--sun-zenith" && i + 1 < args.size()) {
+      suns.push_back(std::atof(args[++i].c_str()));
+    } else if (args[i] == "--shadow-scale" && i + 1 < args.size()) {
+      options.shadow_majorant_scale = std::max(1.0, std::atof(args[++i].c_str()));
+    } else if (args[i] == "--sunlit-segments") {
+      options.explicit_single_scattering = true;
+    } else {
+      std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
+                   "[--shadow-scale S] [--sunlit-segments]\n";
+      return 2;
+    }
+  }
+  if (suns.empty()) suns = {30.0, 85.0, 96.0};
+  for (const double sun : suns) {
+    const EfficiencyResult r = measure(sun, samples, options);
+    const double rel2 = r.relative_std_per_path * r.relative_std_per_path;
+    std::cout << nlohmann::json{{"bench", "efficiency"},
+                                {"sun_zenith_deg", sun},
+                                {"samples_per_direction", samples},
+                                {"shadow_majorant_scale", options.shadow_majorant_scale},
+                                {"sunlit_segments", options.explicit_single_scattering},
+                                {"relative_std_per_path", r.relative_std_per_path},
+                                {"microseconds_per_path", r.microseconds_per_path},
+                                {"efficiency", rel2 > 0.0 ? 1.0 / (rel2 * r.microseconds_per_path) : 0.0},
+                                {"nonfinite", r.counters.nonfinite}}
+                     .dump()
+              << std::endl;
+  }
+  return 0;
+}
+
+}  // namespace skyfarm
