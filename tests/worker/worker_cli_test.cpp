@@ -154,3 +154,28 @@ TEST(WorkerCli, UnwritableOutputIsAClearError) {
 
 }  // namespace
 }  // namespace skyfarm
+
+namespace skyfarm {
+namespace {
+
+// The efficiency bench prints one JSON line per sun, with a finite, positive
+// efficiency and no discarded path.
+TEST(WorkerCli, BenchEfficiencyPrintsOneLinePerSun) {
+  const CommandResult r = run_worker("bench efficiency --samples 4 --sun-zenith 30 --sun-zenith 96");
+  ASSERT_EQ(r.exit_code, 0) << r.out;
+  std::istringstream lines(r.out);
+  int n = 0;
+  for (std::string line; std::getline(lines, line);) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["bench"], "efficiency");
+    EXPECT_GT(j["efficiency"].get<double>(), 0.0) << line;
+    EXPECT_GT(j["relative_std_per_path"].get<double>(), 0.0) << line;
+    EXPECT_EQ(j["nonfinite"], 0) << line;
+    ++n;
+  }
+  EXPECT_EQ(n, 2);
+  EXPECT_EQ(run_worker("bench efficiency --bogus").exit_code, 2);
+}
+
+}  // namespace
+}  // namespace skyfarm
