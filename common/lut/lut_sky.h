@@ -1,0 +1,165 @@
+// The LUT renderer's sky (DESIGN §3.4): Hillaire's (2020) table-based sky,
+// spectral, on the same atmosphere model (Atmosphere, Sun) as the path tracer.
+// Fast and approximate; its error against the path tracer is measured in
+// tests/common/lut/sky_view_lut_test.cpp, never assumed.
+//
+// Parameters (LutResolution; defaults after Hillaire 2020 except where noted)
+//   spectral_bins              equal bins over [lambda_min, lambda_max]
+//                              (default 32: see the table below)
+//   medium_altitude_samples    coefficient table nodes (2048), medium_table.h
+//   phase_samples              tabulated phase function nodes (512)
+//   transmittance_mu/_r/_steps 256 x 128 nodes, 64 quadrature intervals per
+//                              part of a ray (transmittance_lut.h)
+//   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions, 20 steps
+//   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
+//   sky_view_*                 192 azimuths x 108 zenith rows, 30 steps
+//   aerial_*                   32 x 32 x 32 slices up to 64 km
+//   space_view_steps           march steps of a view from above the top (64)
+//
+// Observers inside the atmosphere (altitude <= top) read the sky-view table
+// (sky and ground) and the aerial-perspective table; observers above the
+// top get a march per ray (raymarch_radiance) through the transmittance,
+// multiple-scattering and ground-irradiance tables.  The sun disk adds
+// Sun::radiance (bin mean) times the transmittance of the view ray.
+//
+// Units: radiance W m^-2 sr^-1 nm^-1 per bin (the value at the bin centre of
+// a sun spectrum averaged over the bin; spectral_grid.h), transmittance 1.
+// Every output is finite and >= 0: a value that is not (impossible by
+// construction: all tables are sums of non-negative terms and interpolated
+// with convex weights) is replaced by 0 and counted in sanitized_values(),
+// which tests require to stay 0.  A LutSky is immutable once built; all its
+// const methods may be called from many threads at once, and copies share
+// the tables (with_sun shares the atmosphere's tables between suns).
+//
+// Spectral bins needed for colour (tests/bench/lut_bench.cpp
+// BM_LutBinCountColourError): XYZ of the sky-view radiance with N bins over
+// 360-830 nm against N = 94 (5 nm bins), Earth preset, AM0 sun, observer on
+// the ground, 45 directions (zenith 0, 30, 60, 80, 88, 90 = the horizon, 95,
+// 120, 180 deg x 10-180 deg from the sun's azimuth); worst relative
+// luminance error |Y/Y_94 - 1| and worst CIE 1931 xy distance per sun zenith:
+//      N   sun 30 deg      sun 80 deg      sun 90 deg      sun 96 deg
+//      4   2.4 % 0.023     2.1 % 0.037     23 %  0.058     57 %  0.100
+//      8   0.73 % 0.0076   1.2 % 0.0090    3.0 % 0.0145    7.3 % 0.029
+//     12   0.38 % 0.0011   0.69 % 0.0017   1.0 % 0.0040    3.3 % 0.0100
+//     16   0.33 % 0.0027   0.68 % 0.0037   1.7 % 0.0056    3.7 % 0.0089
+//     24   0.11 % 0.0003   0.22 % 0.0004   0.34 % 0.0011   0.41 % 0.0024
+//     28   0.10 % 0.0008   0.16 % 0.0010   0.42 % 0.0012   0.96 % 0.0022
+//     32   0.09 % 0.0003   0.07 % 0.0003   0.15 % 0.0006   0.41 % 0.0013
+// Only N = 32 meets < 1 % in luminance and < 0.002 in xy everywhere,
+// twilight included (the light that crossed the ozone layer along the
+// horizon is the least smooth spectrum); 16 bins suffice by day for
+// luminance (< 1 %), not for xy (0.003-0.004).  Default: 32.
+//
+// Accuracy against the path tracer (tests/common/lut/sky_view_lut_test.cpp;
+// Earth preset with ground albedo 0.3, 440-680 nm): single scattering agrees
+// to < 1 %; with Hillaire's isotropic multiple scattering the whole sky,
+// LUT/PT - 1 over 6 directions x 4 wavelengths, is -19 % (blue, 1 deg above
+// the horizon) to +24 % (red, anti-solar sky 60 deg up) at noon (sun 30 deg)
+// and -28 % (blue, 5 deg above the horizon) to +6 % with the sun at 80 deg.
+// The approximation spreads the light of the aerosols' forward peak over all
+// directions (with an isotropic scatterer the LUT agrees to 1.2 %).
+//
+// Cost (tests/bench/lut_bench.cpp, one core of a shared 2-core AMD EPYC VM,
+// CPU time, 8 / 16 / 32 bins): all tables 78 / 134 / 165 ms (the
+// transmittance and multiple-scattering tables, which depend on the
+// atmosphere only, are 3/4 of it); the sun-dependent tables alone (with_sun)
+// 14-22 / 18-24 / 27 ms; one radiance look-up 56 / 85 / 97 ns; memory 6.2 /
+// 12.5 / 25 MB.  A timelapse or a cache of many suns should build once and
+// call with_sun.
+#pragma once
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <glm/vec3.hpp>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "common/atmosphere/atmosphere.h"
+#include "common/lut/spectral_grid.h"
+#include "common/sun/sun.h"
+
+namespace skyfarm {
+
+class SkyViewLut;
+class AerialPerspectiveLut;
+
+struct LutResolution {
+  int spectral_bins = 32;
+  int medium_altitude_samples = 2048;
+  int phase_samples = 512;
+  int transmittance_mu = 256, transmittance_r = 128, transmittance_steps = 64;
+  int multiple_scattering_mu_s = 32, multiple_scattering_altitude = 32;
+  int multiple_scattering_directions = 64, multiple_scattering_steps = 20;
+  int ground_irradiance_mu_s = 64, ground_irradiance_directions = 64, ground_irradiance_steps = 20;
+  int sky_view_azimuth = 192, sky_view_zenith = 108, sky_view_steps = 30;
+  int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
+  double aerial_max_distance_m = 64000.0;
+  int space_view_steps = 64;
+};
+
+class LutSky {
+ public:
+  // All tables for one atmosphere, sun and observer altitude (m above the
+  // ground, on the observer frame's +z axis).  Throws std::invalid_argument
+  // for a bad range or resolution.
+  static LutSky build(const Atmosphere& atmosphere, const Sun& sun, double observer_altitude_m, double lambda_min_nm,
+                      double lambda_max_nm, const LutResolution& resolution = {});
+  // The same atmosphere tables (shared, not rebuilt) for another sun and/or
+  // observer altitude: only the sky-view and aerial-perspective tables are built.
+  LutSky with_sun(const Sun& sun) const { return with_sun(sun, observer_altitude_m_); }
+  LutSky with_sun(const Sun& sun, double observer_altitude_m) const;
+
+  const SpectralGrid& grid() const;
+  // E_sun and the disk's radiance per bin (bin means).
+  std::span<const double> sun_irradiance() const { return sun_E_; }
+  std::span<const double> sun_disk_radiance() const { return sun_L_; }
+  double observer_altitude_m() const { return observer_altitude_m_; }
+  bool observer_above_atmosphere() const { return above_; }
+
+  // Radiance arriving at the observer from view_dir (unit, observer frame:
+  // z up, y north, x east), out_per_bin.size() >= grid().size().  The sky-
+  // view table (plus ground) inside the atmosphere, a march from above it.
+  void radiance(const glm::dvec3& view_dir, std::span<double> out_per_bin, bool include_sun_disk) const;
+  // In-scattered radiance and transmittance between the observer and a point
+  // at distance_m along view_dir (aerial-perspective table up to its
+  // max distance, a march beyond it or from above the atmosphere).
+  void aerial_perspective(const glm::dvec3& view_dir, double distance_m, std::span<double> in_scattered,
+                          std::span<double> transmittance) const;
+
+  // Reference-quality march of one ray through the transmittance, multiple-
+  // scattering and ground-irradiance tables (exact phase functions, `steps`
+  // steps placed by lut::place_steps); origin planet-centred, m.  An origin
+  // above the top moves to where the ray enters; rays that miss the
+  // atmosphere see 0 (plus the sun disk).  Also used for views from space.
+  void raymarch_radiance(const glm::dvec3& origin_planet_centred, const glm::dvec3& dir, std::span<double> out_per_bin,
+                         bool include_sun_disk, int steps) const;
+  // The same over [0, distance_m] without the ground: L_in and T.
+  void raymarch_aerial_perspective(const glm::dvec3& origin_planet_centred, const glm::dvec3& dir, double distance_m,
+                                   std::span<double> in_scattered, std::span<double> transmittance, int steps) const;
+
+  std::size_t memory_bytes() const;
+  // Outputs replaced by 0 because they were negative or not finite (see above).
+  std::uint64_t sanitized_values() const;
+  // Multiple-scattering nodes whose f_ms was clamped below 1 (dense media).
+  int clamped_multiple_scattering_nodes() const;
+
+  struct Tables;  // the atmosphere's tables (lut_sky.cpp)
+
+ private:
+  void march(const glm::dvec3& origin, const glm::dvec3& dir, double t_max, int steps, bool ground, bool sun_disk,
+             double* L, double* T) const;
+  void sanitize(std::span<double> values) const;
+
+  std::shared_ptr<const Tables> tables_;
+  std::shared_ptr<const SkyViewLut> sky_view_;          // null above the atmosphere
+  std::shared_ptr<const AerialPerspectiveLut> aerial_;  // null above the atmosphere
+  std::shared_ptr<std::atomic<std::uint64_t>> sanitized_;
+  std::shared_ptr<const Sun> sun_;
+  LutResolution resolution_;
+  std::vector<double> sun_E_, sun_L_;
+  double observer_altitude_m_ = 0.0, observer_r_ = 0.0;
+  bool above_ = false;
+};
+
+}  // namespace skyfarm

@@ -1,0 +1,128 @@
+#include "common/lut/multiple_scattering_lut.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/core/constants.h"
+#include "common/lut/bilinear.h"
+#include "common/lut/fibonacci_directions.h"
+#include "common/lut/invalid_argument.h"
+#include "common/lut/segment_integral.h"
+#include "common/lut/shell_geometry.h"
+#include "common/lut/simd_clones.h"
+
+namespace skyfarm {
+
+namespace {
+constexpr double kMaxFms = 1.0 - 1e-3;
+}  // namespace
+
+SKYFARM_LUT_SIMD_CLONES
+MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, const TransmittanceLut& transmittance,
+                                                   int mu_s_samples, int altitude_samples, int directions, int steps) {
+  if (mu_s_samples < 2 || altitude_samples < 2 || directions < 1 || steps < 1)
+    throw lut::invalid_argument("multiple-scattering LUT: bad resolution ", mu_s_samples, "x", altitude_samples, ", ",
+                                directions, " directions, ", steps, " steps");
+  MultipleScatteringLut m;
+  m.bins_ = medium.bins();
+  m.n_mu_s_ = mu_s_samples;
+  m.n_h_ = altitude_samples;
+  m.top_altitude_ = medium.top_altitude_m();
+  const std::size_t B = static_cast<std::size_t>(m.bins_), S = static_cast<std::size_t>(steps);
+  const std::size_t D = static_cast<std::size_t>(directions);
+  const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
+  m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0);
+  const std::vector<glm::dvec3> dirs = lut::fibonacci_sphere(directions);
+  const std::vector<double>& albedo = medium.ground_albedo();
+  const TransmittanceLut::RadiusCoord ground_rc = transmittance.locate_r(R);
+
+  // Per altitude row, everything that does not depend on the sun: the
+  // weights T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of every step,
+  // the step's T-LUT radius, and mu_s at the step as a sin_s + b mu_s.
+  std::vector<double> W(D * S * B), T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
+  std::vector<TransmittanceLut::RadiusCoord> rc(D * S);
+  std::vector<double> a(D * S), bcoef(D * S), a_g(D), b_g(D), t_mid(S), dt(S);
+  std::vector<char> hits(D);
+  for (int j = 0; j < altitude_samples; ++j) {
+    const double r = R + m.top_altitude_ * j / (altitude_samples - 1);
+    std::fill(f_ms.begin(), f_ms.end(), 0.0);
+    for (std::size_t i = 0; i < D; ++i) {
+      const glm::dvec3& w = dirs[i];
+      const double mu = w.z;
+      hits[i] = lut::ray_hits_ground(r, mu, R);
+      const double t_end = hits[i] ? lut::distance_to_ground(r, mu, R) : lut::distance_to_top(r, mu, R_top);
+      lut::place_steps(r, mu, t_end, steps, t_mid.data(), dt.data());
+      std::fill(T_acc.begin(), T_acc.end(), 1.0);
+      for (std::size_t k = 0; k < S; ++k) {
+        const double rk = lut::radius_at(r, mu, t_mid[k]);
+        const MediumTable::Node node = medium.locate(rk - R);
+        medium.sigma_t(node, s_t.data());
+        medium.sigma_s(node, s_s.data());
+        double* Wk = W.data() + (i * S + k) * B;
+        for (std::size_t b = 0; b < B; ++b) {
+          double integral;
+          const double T_seg = lut::T_and_in_scattering_integral(s_t[b], dt[k], &integral);
+          Wk[b] = T_acc[b] * integral * s_s[b];
+          f_ms[b] += Wk[b];
+          T_acc[b] *= T_seg;
+        }
+        rc[i * S + k] = transmittance.locate_r(rk);
+        // x_t = (0, 0, r) + t w, s = (sin_s, 0, mu_s): x_t . s / r_t.
+        a[i * S + k] = t_mid[k] * w.x / rk;
+        bcoef[i * S + k] = (r + t_mid[k] * w.z) / rk;
+      }
+      if (hits[i]) {
+        std::copy(T_acc.begin(), T_acc.end(), T_ground.begin() + static_cast<std::ptrdiff_t>(i * B));
+        a_g[i] = t_end * w.x / R;
+        b_g[i] = (r + t_end * w.z) / R;
+      }
+    }
+    // f_ms = int p_u (...) dw = mean over the directions (p_u 4 pi / n = 1 / n).
+    for (std::size_t b = 0; b < B; ++b) {
+      f_ms[b] /= static_cast<double>(D);
+      if (!(f_ms[b] <= kMaxFms)) {
+        f_ms[b] = kMaxFms;
+        ++m.clamped_;
+      }
+    }
+    for (int col = 0; col < mu_s_samples; ++col) {
+      const double mu_s = -1.0 + 2.0 * col / (mu_s_samples - 1), sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+      std::fill(L.begin(), L.end(), 0.0);
+      for (std::size_t q = 0; q < D * S; ++q) {
+        const double mu_q = std::clamp(a[q] * sin_s + bcoef[q] * mu_s, -1.0, 1.0);
+        const double u = transmittance.mu_position(rc[q], mu_q);
+        if (u >= 0.0) transmittance.bilinear(rc[q], u).weighted_add(m.bins_, W.data() + q * B, L.data());
+      }
+      for (std::size_t b = 0; b < B; ++b) L[b] *= kInv4Pi;  // the sun's phase p_u
+      // The ground's Lambertian reflection of the attenuated sun (Hillaire's code,
+      // IntegrateScatteredLuminance "bounced light off the earth").
+      for (std::size_t i = 0; i < D; ++i) {
+        if (!hits[i]) continue;
+        const double mu_g = std::clamp(a_g[i] * sin_s + b_g[i] * mu_s, -1.0, 1.0);
+        if (mu_g <= 0.0) continue;
+        transmittance.lookup(ground_rc, transmittance.mu_position(ground_rc, mu_g), T_sun.data());
+        for (std::size_t b = 0; b < B; ++b) L[b] += T_ground[i * B + b] * T_sun[b] * mu_g * albedo[b] * kInvPi;
+      }
+      double* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
+      for (std::size_t b = 0; b < B; ++b) out[b] = (L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]);
+    }
+  }
+  return m;
+}
+
+MultipleScatteringLut::AltitudeCoord MultipleScatteringLut::locate_altitude(double altitude_m) const {
+  const double u = std::clamp(altitude_m / top_altitude_, 0.0, 1.0) * (n_h_ - 1);
+  const std::size_t j = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_h_ - 2));
+  return {j * static_cast<std::size_t>(n_mu_s_) * static_cast<std::size_t>(bins_), u - static_cast<double>(j)};
+}
+
+void MultipleScatteringLut::lookup(const AltitudeCoord& a, double u, double* out) const {
+  bilinear(a, u).eval(bins_, out);
+}
+
+void MultipleScatteringLut::lookup_weighted_add(const AltitudeCoord& a, double u, const double* weight,
+                                                double* acc) const {
+  bilinear(a, u).weighted_add(bins_, weight, acc);
+}
+
+}  // namespace skyfarm

@@ -1,0 +1,181 @@
+#include "common/lut/scattering_march.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/core/constants.h"
+#include "common/lut/ground_irradiance_lut.h"
+#include "common/lut/segment_integral.h"
+#include "common/lut/shell_geometry.h"
+
+namespace skyfarm {
+
+namespace {
+
+// L[b] += (w0 p0 + c1 w1 p1)[b] T_sun[b] + w_ms[b] Psi[b], T_sun and Psi
+// bilinear from their tables: the sky-view build's innermost loop, one pass
+// over the bins.  (__restrict: L never overlaps the tables or weights;
+// without it the loop needs more run-time alias checks than GCC emits, and
+// stays scalar.)
+inline void add_source(std::size_t B, double* __restrict L, const double* w0, const double* p0, const double* w1,
+                       const double* p1, double c1, const lut::Bilinear& t, const double* w_ms,
+                       const lut::Bilinear& m) {
+  const double *t00 = t.v00, *t01 = t.v01, *t10 = t.v10, *t11 = t.v11;
+  const double *m00 = m.v00, *m01 = m.v01, *m10 = m.v10, *m11 = m.v11;
+  const double tw00 = t.w00, tw01 = t.w01, tw10 = t.w10, tw11 = t.w11;
+  const double mw00 = m.w00, mw01 = m.w01, mw10 = m.w10, mw11 = m.w11;
+  for (std::size_t b = 0; b < B; ++b) {
+    const double T_sun = tw00 * t00[b] + tw01 * t01[b] + tw10 * t10[b] + tw11 * t11[b];
+    const double psi = mw00 * m00[b] + mw01 * m01[b] + mw10 * m10[b] + mw11 * m11[b];
+    L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
+  }
+}
+
+}  // namespace
+
+ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceLut& transmittance,
+                                 const MultipleScatteringLut* multiple_scattering,
+                                 const GroundIrradianceLut* ground_irradiance)
+    : medium_(medium),
+      transmittance_(transmittance),
+      ms_(multiple_scattering),
+      gi_(ground_irradiance),
+      bins_(medium.bins()),
+      scatterers_(medium.scatterers()) {
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  s_t_.resize(B);
+  s_s_.resize(B);
+  s_c_.resize(C * B);
+  w_phase_.resize(B);
+  tmp_.resize(B);
+}
+
+void ScatteringMarch::prepare(double r0, double mu, double t_end, bool ends_on_ground, int steps) {
+  steps_ = std::max(1, steps);
+  t_mid_.resize(static_cast<std::size_t>(steps_));
+  dt_.resize(static_cast<std::size_t>(steps_));
+  lut::place_steps(r0, mu, t_end, steps_, t_mid_.data(), dt_.data());
+  t_end_ = t_end;
+  prepare_steps(r0, mu, ends_on_ground);
+}
+
+void ScatteringMarch::prepare_boundaries(double r0, double mu, std::span<const double> boundaries,
+                                         bool ends_on_ground) {
+  steps_ = std::max<int>(1, static_cast<int>(boundaries.size()) - 1);
+  t_mid_.assign(static_cast<std::size_t>(steps_), 0.0);
+  dt_.assign(static_cast<std::size_t>(steps_), 0.0);
+  for (std::size_t k = 0; k + 1 < boundaries.size(); ++k) {
+    t_mid_[k] = 0.5 * (boundaries[k] + boundaries[k + 1]);
+    dt_[k] = boundaries[k + 1] - boundaries[k];
+  }
+  t_end_ = boundaries.empty() ? 0.0 : boundaries.back();
+  prepare_steps(r0, mu, ends_on_ground);
+}
+
+// The sun-independent part: per step the coefficients at the midpoint, the
+// segment's transmittance and in-scattering integral, and the weights.
+void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  const std::size_t S = static_cast<std::size_t>(steps_);
+  const double R = medium_.planet_radius_m();
+  r0_ = r0;
+  ends_on_ground_ = ends_on_ground;
+  w_c_.resize(S * C * B);
+  w_ms_.resize(S * B);
+  T_before_.resize((S + 1) * B);
+  radius_.resize(S);
+  ms_altitude_.resize(S);
+  c_mu_.resize(S);
+  c_nu_.resize(S);
+  std::fill(T_before_.begin(), T_before_.begin() + static_cast<std::ptrdiff_t>(B), 1.0);
+  for (std::size_t k = 0; k < S; ++k) {
+    const double rk = std::max(R, lut::radius_at(r0, mu, t_mid_[k]));
+    const double altitude = rk - R;
+    radius_[k] = transmittance_.locate_r(rk);
+    if (ms_) ms_altitude_[k] = ms_->locate_altitude(altitude);
+    c_mu_[k] = r0 / rk;
+    c_nu_[k] = t_mid_[k] / rk;
+    const MediumTable::Node node = medium_.locate(altitude);
+    medium_.sigma_t(node, s_t_.data());
+    medium_.sigma_s(node, s_s_.data());
+    medium_.sigma_s_per_scatterer(node, s_c_.data());
+    const double* T0 = T_before_.data() + k * B;
+    double* T1 = T_before_.data() + (k + 1) * B;
+    double* wms = w_ms_.data() + k * B;
+    double* wc = w_c_.data() + k * C * B;
+    for (std::size_t b = 0; b < B; ++b) {
+      double integral;
+      T1[b] = T0[b] * lut::T_and_in_scattering_integral(s_t_[b], dt_[k], &integral);
+      const double w = T0[b] * integral;
+      wms[b] = w * s_s_[b];
+      for (std::size_t c = 0; c < C; ++c) wc[c * B + b] = w * s_c_[c * B + b];
+    }
+  }
+}
+
+SKYFARM_LUT_SIMD_CLONES
+void ScatteringMarch::add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1,
+                                       double* L) const {
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  const std::size_t N = static_cast<std::size_t>(std::max(0, n));
+  if (u_T_.size() < N) {
+    u_T_.resize(N);
+    u_ms_.resize(N);
+  }
+  double* u_T = u_T_.data();
+  double* u_ms = u_ms_.data();
+  for (int kk = std::max(0, k0); kk < std::min(k1, steps_); ++kk) {
+    const std::size_t k = static_cast<std::size_t>(kk);
+    const TransmittanceLut::RadiusCoord rc = radius_[k];
+    const double a = c_mu_[k] * mu_s0, c = c_nu_[k];
+    // Where each view's mu_s(t_k) falls in the transmittance and multiple-
+    // scattering tables (u_T < 0: the planet hides the sun).
+    const double ms_nodes = ms_ ? ms_->mu_s_samples() - 1 : 0.0;
+    for (std::size_t i = 0; i < N; ++i) {
+      const double mu_s = std::min(1.0, std::max(-1.0, a + c * nu[i]));
+      u_T[i] = transmittance_.mu_position(rc, mu_s);
+      u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
+    }
+    const double* wc = w_c_.data() + k * C * B;
+    const double* wms = w_ms_.data() + k * B;
+    for (std::size_t i = 0; i < N; ++i) {
+      double* Li = L + i * B;
+      const double* p = phase + i * C * B;
+      // One fused pass over the bins: J = T_sun sum_c w_c p_c + w_ms Psi_ms.
+      const bool lit = u_T[i] >= 0.0;
+      if (lit && ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer
+        const lut::Bilinear t = transmittance_.bilinear(rc, u_T[i]), m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
+        const double* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
+        const double* p1 = C == 2 ? p + B : p;
+        add_source(B, Li, wc, p, wc1, p1, C == 2 ? 1.0 : 0.0, t, wms, m);
+        continue;
+      }
+      if (lit && C > 0) {  // the general case: any number of scatterers, with or without Psi_ms
+        for (std::size_t b = 0; b < B; ++b) w_phase_[b] = wc[b] * p[b];
+        for (std::size_t cc = 1; cc < C; ++cc)
+          for (std::size_t b = 0; b < B; ++b) w_phase_[b] += wc[cc * B + b] * p[cc * B + b];
+        transmittance_.lookup_weighted_add(rc, u_T[i], w_phase_.data(), Li);
+      }
+      if (ms_) ms_->lookup_weighted_add(ms_altitude_[k], u_ms[i], wms, Li);
+    }
+  }
+}
+
+void ScatteringMarch::add_ground(double nu, double mu_s0, double* L) const {
+  if (!ends_on_ground_) return;
+  const std::size_t B = static_cast<std::size_t>(bins_);
+  const double R = medium_.planet_radius_m();
+  const double mu_g = std::clamp((r0_ * mu_s0 + t_end_ * nu) / R, -1.0, 1.0);
+  // Direct sun on the ground: E T_sun max(0, n . s); sky light: E I(mu_g).
+  std::fill(tmp_.begin(), tmp_.end(), 0.0);
+  if (mu_g > 0.0) {
+    transmittance_.to_top(R, mu_g, tmp_.data());  // 0 if mu_g <= 0 anyway
+    for (std::size_t b = 0; b < B; ++b) tmp_[b] *= mu_g;
+  }
+  if (gi_) gi_->lookup_add(mu_g, tmp_.data());
+  const double* T_end = T_before(steps_);
+  const std::vector<double>& albedo = medium_.ground_albedo();
+  for (std::size_t b = 0; b < B; ++b) L[b] += T_end[b] * albedo[b] * kInvPi * tmp_[b];
+}
+
+}  // namespace skyfarm
