@@ -13,10 +13,15 @@ RenderSetup make_render_setup(const RenderRequest& request) {
 
 RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
   constexpr int kTileSize = 32, kSamplesPerPass = 16;
-  return make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                          request.spectral.max_nm, request.spectral.batches, request.quality.samples_per_pixel,
-                          request.seed, kTileSize, kSamplesPerPass,
-                          mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
+  const bool lut = request.method == Method::kLut;
+  // The LUT renderer is deterministic: one sample per pixel and batch, one pass.
+  RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
+                                     request.spectral.max_nm, request.spectral.batches,
+                                     lut ? 1 : request.quality.samples_per_pixel, request.seed, kTileSize,
+                                     lut ? 1 : kSamplesPerPass,
+                                     mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
+  plan.lut = lut;
+  return plan;
 }
 
 }  // namespace skyfarm::api
@@ -39,7 +44,9 @@ void set_render_metadata(Image* image, const RenderRequest& request, const Rende
     image->set_metadata(key::kEstimatedRelativeRmsG, e->g);
     image->set_metadata(key::kEstimatedRelativeRmsB, e->b);
   }
-  image->set_metadata("method", std::string("path"));
+  image->set_metadata("method", std::string(plan.lut ? "lut" : "path"));
+  if (plan.lut)
+    image->set_metadata("approximate", std::string("table-based sky (Hillaire 2020); error against the path tracer: README"));
   image->set_metadata("earth_sun_distance_au", sun.distance_au());
 }
 

@@ -83,7 +83,8 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
   }
   return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
-          {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored}};
+          {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
+          {"method", plan.lut ? "lut" : "path"}};
 }
 
 }  // namespace
@@ -308,6 +309,10 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
   }
   return {{"id", job.record.id},
           {"state", job.record.state},
+          {"method", job.plan.lut ? "lut" : "path"},
+          // The LUT renderer's error is its bias against the path tracer
+          // (README "LUT accuracy"); it has no Monte Carlo estimate.
+          {"approximate", job.plan.lut},
           {"priority", job.record.priority},
           {"progress",
            {{"fraction", fraction}, {"samples_per_pixel", spp}, {"units_done", merged}, {"units_total", total}}},

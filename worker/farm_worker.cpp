@@ -85,10 +85,6 @@ class SetupCache {
     e.built = true;
     try {
       const api::RenderRequest request = api::parse_render_request(e.request);
-      if (request.method != api::Method::kPath) {
-        e.error = "method \"lut\" is not available on this worker; use \"path\"";
-        return;
-      }
       e.job.setup = api::make_render_setup(request);
       e.job.renderer = std::make_unique<TileRenderer>(*e.job.setup.scene, *e.job.setup.camera, e.job.setup.plan);
     } catch (const api::ValidationError& ex) {

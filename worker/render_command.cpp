@@ -11,6 +11,7 @@
 #include "api/field_error.h"
 #include "api/probe_request.h"
 #include "api/render_request.h"
+#include "api/probe_answer.h"
 #include "api/render_setup.h"
 #include "common/core/constants.h"
 #include "common/image/exr_writer.h"
@@ -66,10 +67,6 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
 
 int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
                     int threads, const std::string& label, int png_bits = 8) {
-  if (request.method == api::Method::kLut) {
-    std::cerr << "skyfarm-worker render: method \"lut\" is not available yet; use \"path\"\n";
-    return 2;
-  }
   const auto t0 = std::chrono::steady_clock::now();
   const api::RenderSetup setup = api::make_render_setup(request);
   const Scene& scene = *setup.scene;
@@ -204,34 +201,7 @@ int run_probe_command(const std::vector<std::string>& args) {
   }
   try {
     const api::ProbeRequest request = api::parse_probe_request(text);
-    if (request.method == api::Method::kLut) {
-      std::cerr << "skyfarm-worker probe: method \"lut\" is not available yet; use \"path\"\n";
-      return 2;
-    }
-    const auto [lmin, lmax] = std::minmax_element(request.wavelengths_nm.begin(), request.wavelengths_nm.end());
-    // The majorant grid must cover every asked wavelength; 1 nm margin.
-    const Scene scene = Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
-                                          *lmin - 0.5, *lmax + 0.5);
-    std::vector<glm::dvec3> dirs;
-    nlohmann::json dirs_json = nlohmann::json::array();
-    for (const auto& d : request.directions) {
-      dirs.push_back(direction_from_zenith_azimuth(d.zenith_deg * kDegToRad, d.azimuth_deg * kDegToRad));
-      dirs_json.push_back({{"zenith_deg", d.zenith_deg}, {"azimuth_deg", d.azimuth_deg}});
-    }
-    const auto t0 = std::chrono::steady_clock::now();
-    const ProbeResult r = probe_radiance(scene, dirs, request.wavelengths_nm, request.samples, request.seed, threads);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    nlohmann::json out = {{"units", "W m-2 sr-1 nm-1"},
-                          {"wavelengths_nm", request.wavelengths_nm},
-                          {"directions", dirs_json},
-                          {"radiance", r.radiance},
-                          {"standard_error", r.standard_error},
-                          {"samples", request.samples},
-                          {"seed", request.seed},
-                          {"method", "path"},
-                          {"sun", {{"zenith_deg", scene.sun().zenith_deg()}, {"azimuth_deg", scene.sun().azimuth_deg()}}},
-                          {"elapsed_s", seconds},
-                          {"nonfinite_paths", r.counters.nonfinite}};
+    const nlohmann::json out = api::answer_probe(request, threads);
     std::cout << out.dump(2) << "\n";
     return 0;
   } catch (const api::ValidationError& e) {

@@ -37,6 +37,9 @@ struct RenderPlan {
   // vertical plane, only columns [0, width / 2) are rendered (tiles cover
   // them alone) and the right half is their mirror image (mirror_image.h).
   bool mirrored = false;
+  // The LUT renderer (method "lut", common/lut/): one deterministic sample
+  // per pixel and batch from the tables instead of paths; approximate.
+  bool lut = false;
   int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }

@@ -33,6 +33,7 @@ class Scene {
   const Sun& sun() const { return sun_; }
   // Planet-centred observer position (0, 0, R + altitude).
   glm::dvec3 observer() const { return observer_; }
+  double observer_altitude_m() const { return observer_.z - atmosphere_->planet_radius_m(); }
   double lambda_min_nm() const { return lambda_min_; }
   double lambda_max_nm() const { return lambda_max_; }
 

@@ -1,5 +1,10 @@
 #include "common/render/tile_renderer.h"
 
+#include <algorithm>
+#include <vector>
+
+#include "common/lut/lut_sky.h"
+#include "common/lut/spectral_grid.h"
 #include "common/render/sun_pixels.h"
 #include "common/spectrum/color.h"
 
@@ -7,7 +12,57 @@ namespace skyfarm {
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
                            IntegratorOptions options)
-    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, options), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())) {}
+    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, options), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())) {
+  if (plan_.lut)
+    lut_ = std::make_shared<const LutSky>(LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),
+                                                        plan_.lambda_min_nm, plan_.lambda_max_nm));
+}
+
+TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
+                           std::shared_ptr<const LutSky> lut)
+    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())),
+      lut_(std::move(lut)) {
+  plan_.lut = true;
+}
+
+// One LUT sample per pixel: the centre's radiance, or for pixels that see
+// the sun disk the mean of kSub x kSub sub-pixel directions (the disk is
+// 0.27 deg across, often less than a pixel: a centre sample would hit or
+// miss it whole).
+void TileRenderer::render_unit_lut(const WorkUnit& unit, FilmTile* film) const {
+  constexpr int kSub = 8;
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  plan_.tile_rect(unit.tile, &x0, &y0, &w, &h);
+  const BinnedSpectrumIntegral band(lut_->grid(), plan_.batch_min_nm(unit.batch), plan_.batch_max_nm(unit.batch));
+  const std::size_t n = static_cast<std::size_t>(lut_->grid().size());
+  std::vector<double> L(n), L_sub(n);
+  for (int y = y0; y < y0 + h; ++y) {
+    for (int x = x0; x < x0 + w; ++x) {
+      if (!camera_.pixel_exists(x, y)) continue;
+      const std::uint32_t pixel = static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(plan_.width) +
+                                  static_cast<std::uint32_t>(x);
+      const bool sees_sun = std::binary_search(sun_pixels_.begin(), sun_pixels_.end(), pixel);
+      Ray ray;
+      if (!sees_sun) {
+        if (!camera_.generate_ray(x, y, 0.5, 0.5, &ray)) continue;
+        lut_->radiance(ray.d, L, true);
+      } else {
+        std::fill(L.begin(), L.end(), 0.0);
+        int count = 0;
+        for (int j = 0; j < kSub; ++j)
+          for (int i = 0; i < kSub; ++i) {
+            if (!camera_.generate_ray(x, y, (i + 0.5) / kSub, (j + 0.5) / kSub, &ray)) continue;
+            lut_->radiance(ray.d, L_sub, true);
+            for (std::size_t k = 0; k < n; ++k) L[k] += L_sub[k];
+            ++count;
+          }
+        if (count == 0) continue;
+        for (double& v : L) v /= count;
+      }
+      film->add_sample(x, y, unit.batch, band.xyz(L), band.band_mean(L));
+    }
+  }
+}
 
 FilmTile TileRenderer::empty_tile(int tile) const {
   int x0 = 0, y0 = 0, w = 0, h = 0;
@@ -16,6 +71,10 @@ FilmTile TileRenderer::empty_tile(int tile) const {
 }
 
 void TileRenderer::render_unit(const WorkUnit& unit, FilmTile* film, PathCounters* counters) const {
+  if (lut_) {
+    render_unit_lut(unit, film);
+    return;
+  }
   int x0 = 0, y0 = 0, w = 0, h = 0;
   plan_.tile_rect(unit.tile, &x0, &y0, &w, &h);
   const double l0 = plan_.batch_min_nm(unit.batch), l1 = plan_.batch_max_nm(unit.batch);

@@ -4,7 +4,15 @@
 // its XYZ and band radiance added to the film.  Samples whose film point has
 // no direction (outside a fisheye's circle) are not counted, so an edge
 // pixel is the mean over its part inside the circle.
+//
+// With plan.lut the pixels come from the LUT renderer (common/lut/lut_sky.h)
+// instead: the sky at the pixel's centre, and for the pixels that see the
+// sun disk the mean over 8 x 8 sub-pixel directions, so the disk's energy
+// lands where the path tracer puts it; one sample per pixel and batch,
+// deterministic.  The tables are built once per renderer (or shared).
 #pragma once
+#include <memory>
+
 #include "common/camera/camera.h"
 #include "common/film/film_tile.h"
 #include "common/render/render_plan.h"
@@ -12,9 +20,14 @@
 
 namespace skyfarm {
 
+class LutSky;
+
 class TileRenderer {
  public:
   TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan, IntegratorOptions options = {});
+  // A LUT renderer on tables built elsewhere (a cache); `lut` must match the scene.
+  TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
+               std::shared_ptr<const LutSky> lut);
 
   // A fresh film tile for tile t (all batches, zero).
   FilmTile empty_tile(int tile) const;
@@ -28,11 +41,14 @@ class TileRenderer {
   const std::vector<std::uint32_t>& sun_pixels() const { return sun_pixels_; }
 
  private:
+  void render_unit_lut(const WorkUnit& unit, FilmTile* film) const;
+
   const Scene& scene_;
   const Camera& camera_;
   RenderPlan plan_;
   VolumePathIntegrator integrator_;
   std::vector<std::uint32_t> sun_pixels_;
+  std::shared_ptr<const LutSky> lut_;  // plan.lut only
 };
 
 }  // namespace skyfarm

@@ -360,5 +360,33 @@ TEST(JobService, MirroredJobRendersHalfAndMatchesTheLocalRender) {
   EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kMirrored));
 }
 
+// method "lut": one pass of one sample per pixel and batch, labelled
+// approximate, no Monte Carlo estimate, and the farm's bytes equal a local
+// LUT render's (the tables are deterministic).
+TEST(JobService, LutJobIsOnePassApproximateAndMatchesTheLocalRender) {
+  constexpr const char* kLut = R"({
+    "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "fisheye", "width": 48, "height": 48, "pitch_deg": 90, "fov_deg": 180},
+    "spectral": {"batches": 2},
+    "method": "lut",
+    "output": {"half": false}
+  })";
+  const fs::path dir = fresh_dir("lut");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kLut), std::nullopt).id;
+  const auto before = *service.status(id);
+  EXPECT_EQ(before["method"], "lut");
+  EXPECT_EQ(before["approximate"], true);
+  EXPECT_EQ(before["plan"]["passes"], 1);
+  EXPECT_EQ(before["plan"]["units"], 4 * 2);  // 2 x 2 tiles x 2 batches
+  std::mt19937 rng(8);
+  run_shuffled(service, rng, 3);
+  const auto s = *service.status(id);
+  ASSERT_EQ(s["state"], "done");
+  EXPECT_EQ(s["progress"]["samples_per_pixel"], 1);
+  EXPECT_TRUE(s["error"]["estimated_relative_rms"].is_null()) << "a LUT render has no Monte Carlo estimate";
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kLut));
+}
+
 }  // namespace
 }  // namespace skyfarm::server
