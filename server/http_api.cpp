@@ -14,6 +14,7 @@
 #include "server/http_checks.h"
 #include "server/http_openapi.h"
 #include "server/http_problem.h"
+#include "server/http_sky.h"
 
 namespace skyfarm::server {
 namespace {
@@ -71,7 +72,8 @@ nlohmann::json render_links(const std::string& id) {
 // "GET, HEAD, POST" for a path the API serves with other methods, else nullopt.
 std::optional<std::string_view> allowed_methods(std::string_view path) {
   if (path == "/v1/renders") return "GET, HEAD, POST";
-  if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics")
+  if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
+      path == "/v1/sky" || path == "/v1/sky/envmap.exr")
     return "GET, HEAD";
   constexpr std::string_view kPrefix = "/v1/renders/";
   if (!path.starts_with(kPrefix)) return std::nullopt;
@@ -214,7 +216,13 @@ struct FileSource {
 }  // namespace
 
 HttpApi::HttpApi(HttpBackend& backend, HttpOptions options)
-    : backend_(backend), options_(std::move(options)), streams_(std::max(0, options_.max_concurrent_streams)) {}
+    : backend_(backend),
+      options_(std::move(options)),
+      streams_(std::max(0, options_.max_concurrent_streams)),
+      sky_(std::make_unique<SkyHttp>(options_.sky ? options_.sky : std::make_shared<SkyService>(),
+                                     options_.token.has_value())) {}
+
+HttpApi::~HttpApi() = default;
 
 void HttpApi::register_routes(httplib::Server& server) {
   configure_server(server);
@@ -321,6 +329,8 @@ void HttpApi::add_routes(httplib::Server& server) {
   server.Get(id + R"(/image\.png)", guarded(&HttpApi::image_png));
   server.Get(id + "/events", guarded(&HttpApi::events));
   server.Get("/v1/workers", guarded(&HttpApi::workers));
+  server.Get("/v1/sky", guarded(&HttpApi::sky));
+  server.Get(R"(/v1/sky/envmap\.exr)", guarded(&HttpApi::sky_envmap));
   server.Get(R"(/v1/openapi\.yaml)", guarded(&HttpApi::openapi));
   server.Get("/healthz", guarded(&HttpApi::healthz));
   server.Get("/metrics", guarded(&HttpApi::metrics));
@@ -453,6 +463,9 @@ void HttpApi::events(const Request& req, Response& res) {
 
 void HttpApi::workers(const Request&, Response& res) { send_json(res, 200, {{"workers", backend_.workers()}}); }
 
+void HttpApi::sky(const Request& req, Response& res) { sky_->lookup(req, res); }
+void HttpApi::sky_envmap(const Request& req, Response& res) { sky_->envmap(req, res); }
+
 void HttpApi::openapi(const Request&, Response& res) {
   const std::string_view text = openapi_yaml();
   if (text.empty()) throw http_error(500, "the OpenAPI document was not built into this server");
@@ -464,7 +477,9 @@ void HttpApi::healthz(const Request&, Response& res) { send_json(res, 200, {{"st
 
 void HttpApi::metrics(const Request&, Response& res) {
   res.status = 200;
-  res.set_content(prometheus_text(backend_.metrics(), responses_, open_streams()), kPrometheusContentType);
+  std::string text = prometheus_text(backend_.metrics(), responses_, open_streams());
+  append_sky_cache_metrics(text, sky_->service().stats());
+  res.set_content(std::move(text), kPrometheusContentType);
 }
 
 void HttpApi::fallback(const Request& req, Response& res) {

@@ -13,6 +13,9 @@
 //   GET    /v1/renders/{id}/image.png   If-None-Match -> 304; 409 before the first pass
 //   GET    /v1/renders/{id}/events      text/event-stream, Last-Event-ID resumes
 //   GET    /v1/workers                  {"workers": [...]}
+//   GET    /v1/sky?...                  radiance in one direction from a cached LUT sky (JSON);
+//   GET    /v1/sky/envmap.exr?...       a cached lat-long environment map; both with strong
+//                                       ETags, If-None-Match -> 304 (server/http_sky.h)
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)
 //   GET    /healthz                     {"status": "ok"}; never needs the token
 //   GET    /metrics                     Prometheus text (text/plain; version=0.0.4)
@@ -31,7 +34,8 @@
 // Options: `token` (bearer token on every route but /healthz; compared in
 // constant time), `max_body_bytes`, `max_json_depth` (stricter than the
 // parser's own 32 when lower), `max_concurrent_streams`, `sse_keepalive`,
-// `http_threads` (httplib's pool), `on_response` (access log hook).
+// `http_threads` (httplib's pool), `on_response` (access log hook), `sky`
+// (the sky look-ups' caches, shared; a default one when null).
 //
 // register_routes() also configures the server: payload limit, timeouts,
 // keep-alive, thread pool, error/exception handlers and the logger (see
@@ -49,6 +53,7 @@
 #include "server/http_events.h"
 #include "server/http_metrics.h"
 #include "server/job_service.h"
+#include "server/sky_service.h"
 
 namespace httplib {
 class Server;
@@ -58,6 +63,8 @@ struct Response;
 }  // namespace httplib
 
 namespace skyfarm::server {
+
+class SkyHttp;
 
 struct HttpOptions {
   std::optional<std::string> token;          // bearer token required on every route but /healthz when set
@@ -70,11 +77,14 @@ struct HttpOptions {
   int http_threads = 0;
   // Called after every response (access logging); may be empty.
   std::function<void(const httplib::Request&, const httplib::Response&)> on_response;
+  // The sky look-ups' caches (/v1/sky, /v1/sky/envmap.exr); null: a default SkyService.
+  std::shared_ptr<SkyService> sky;
 };
 
 class HttpApi {
  public:
   HttpApi(HttpBackend& backend, HttpOptions options);
+  ~HttpApi();
   HttpApi(const HttpApi&) = delete;
   HttpApi& operator=(const HttpApi&) = delete;
 
@@ -110,6 +120,8 @@ class HttpApi {
   void image_png(const httplib::Request& req, httplib::Response& res);
   void events(const httplib::Request& req, httplib::Response& res);
   void workers(const httplib::Request& req, httplib::Response& res);
+  void sky(const httplib::Request& req, httplib::Response& res);
+  void sky_envmap(const httplib::Request& req, httplib::Response& res);
   void openapi(const httplib::Request& req, httplib::Response& res);
   void healthz(const httplib::Request& req, httplib::Response& res);
   void metrics(const httplib::Request& req, httplib::Response& res);
@@ -127,6 +139,7 @@ class HttpApi {
   const HttpOptions options_;
   StreamSlots streams_;
   ResponseCounter responses_;
+  std::unique_ptr<SkyHttp> sky_;
 };
 
 }  // namespace skyfarm::server

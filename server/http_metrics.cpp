@@ -5,6 +5,8 @@
 #include <set>
 #include <string_view>
 
+#include "server/sky_service.h"
+
 namespace skyfarm::server {
 namespace {
 
@@ -120,6 +122,40 @@ std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter
   header(out, "skyfarm_http_event_streams", "gauge", "Open Server-Sent Events streams.");
   sample(out, "skyfarm_http_event_streams", "", std::to_string(open_event_streams));
   return out;
+}
+
+void append_sky_cache_metrics(std::string& out, const SkyCacheStats& s) {
+  struct Pair {
+    std::string_view name, type, help;
+    double table, envmap;
+  };
+  const Pair pairs[] = {
+      {"skyfarm_sky_cache_hits_total", "counter", "Sky look-ups answered from the cache.",
+       double(s.table_hits), double(s.envmap_hits)},
+      {"skyfarm_sky_cache_misses_total", "counter", "Sky look-ups that started a build.",
+       double(s.table_misses), double(s.envmap_misses)},
+      {"skyfarm_sky_cache_waits_total", "counter", "Sky look-ups that waited for a build already in progress.",
+       double(s.table_waits), double(s.envmap_waits)},
+      {"skyfarm_sky_cache_builds_total", "counter", "Sky cache entries built.",
+       double(s.table_builds), double(s.envmap_builds)},
+      {"skyfarm_sky_cache_build_failures_total", "counter", "Sky cache builds that failed (not cached).",
+       double(s.table_build_failures), double(s.envmap_build_failures)},
+      {"skyfarm_sky_cache_evictions_total", "counter", "Sky cache entries evicted to stay within the byte bound.",
+       double(s.table_evictions), double(s.envmap_evictions)},
+      {"skyfarm_sky_cache_bytes", "gauge", "Bytes held by the sky cache.",
+       double(s.table_bytes), double(s.envmap_bytes)},
+      {"skyfarm_sky_cache_entries", "gauge", "Entries in the sky cache.",
+       double(s.table_entries), double(s.envmap_entries)},
+      {"skyfarm_sky_cache_capacity_bytes", "gauge", "Byte bound of the sky cache.",
+       double(s.table_capacity_bytes), double(s.envmap_capacity_bytes)},
+  };
+  for (const auto& p : pairs) {
+    header(out, p.name, p.type, p.help);
+    sample(out, p.name, "cache=\"table\"", format_value(p.table));
+    sample(out, p.name, "cache=\"envmap\"", format_value(p.envmap));
+  }
+  header(out, "skyfarm_sky_cache_build_seconds_total", "counter", "Seconds spent building sky tables.");
+  sample(out, "skyfarm_sky_cache_build_seconds_total", "cache=\"table\"", format_value(s.table_build_seconds));
 }
 
 }  // namespace skyfarm::server

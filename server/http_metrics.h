@@ -34,4 +34,13 @@ class ResponseCounter {
 std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter& responses,
                             int open_event_streams);
 
+// The sky look-up caches (server/sky_service.h), appended to `out`, labelled
+// cache="table" (built LUT skies) and cache="envmap" (encoded maps):
+//   skyfarm_sky_cache_hits_total, _misses_total, _waits_total (waited for a
+//   build in progress), _builds_total, _build_failures_total, _evictions_total
+//   (counters), skyfarm_sky_cache_bytes, _entries, _capacity_bytes (gauges),
+//   and skyfarm_sky_cache_build_seconds_total{cache="table"} (counter).
+struct SkyCacheStats;
+void append_sky_cache_metrics(std::string& out, const SkyCacheStats& stats);
+
 }  // namespace skyfarm::server
