@@ -16,6 +16,7 @@
 #include "common/render/parallel.h"
 #include "worker/bench_convergence.h"
 #include "worker/bench_efficiency.h"
+#include "worker/bench_lut_vs_path.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
 
@@ -116,6 +117,8 @@ int run_bench_command(const std::vector<std::string>& args) {
       repeat = std::max(1, std::atoi(args[++i].c_str()));
     } else if (args[i] == "convergence") {
       return run_bench_convergence(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
+    } else if (args[i] == "lut-vs-path") {
+      return run_bench_lut_vs_path(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "efficiency") {
       return run_bench_efficiency(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "paths" || args[i] == "demo" || args[i] == "memory" || args[i] == "all") {
@@ -124,7 +127,8 @@ int run_bench_command(const std::vector<std::string>& args) {
       std::cerr << "usage: skyfarm-worker bench [paths|demo|memory|all] [--repeat N]\n"
                    "       skyfarm-worker bench convergence [--out DIR] [--passes N]\n"
                    "       skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] [--shadow-scale S] "
-                   "[--sunlit-segments]\n";
+                   "[--sunlit-segments]\n"
+                   "       skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]\n";
       return 2;
     }
   }
