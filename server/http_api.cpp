@@ -15,6 +15,7 @@
 #include "server/http_openapi.h"
 #include "server/http_problem.h"
 #include "server/http_sky.h"
+#include "api/probe_answer.h"
 
 namespace skyfarm::server {
 namespace {
@@ -72,6 +73,7 @@ nlohmann::json render_links(const std::string& id) {
 // "GET, HEAD, POST" for a path the API serves with other methods, else nullopt.
 std::optional<std::string_view> allowed_methods(std::string_view path) {
   if (path == "/v1/renders") return "GET, HEAD, POST";
+  if (path == "/v1/sky/radiance") return "POST";
   if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
       path == "/v1/sky" || path == "/v1/sky/envmap.exr")
     return "GET, HEAD";
@@ -330,6 +332,9 @@ void HttpApi::add_routes(httplib::Server& server) {
   server.Get(id + "/events", guarded(&HttpApi::events));
   server.Get("/v1/workers", guarded(&HttpApi::workers));
   server.Get("/v1/sky", guarded(&HttpApi::sky));
+  server.Post("/v1/sky/radiance", WithReader([this](const Request& req, Response& res, const ContentReader& reader) {
+    run_guarded(req, res, [&] { sky_radiance(req, res, reader); });
+  }));
   server.Get(R"(/v1/sky/envmap\.exr)", guarded(&HttpApi::sky_envmap));
   server.Get(R"(/v1/openapi\.yaml)", guarded(&HttpApi::openapi));
   server.Get("/healthz", guarded(&HttpApi::healthz));
@@ -464,6 +469,32 @@ void HttpApi::events(const Request& req, Response& res) {
 void HttpApi::workers(const Request&, Response& res) { send_json(res, 200, {{"workers", backend_.workers()}}); }
 
 void HttpApi::sky(const Request& req, Response& res) { sky_->lookup(req, res); }
+
+// POST /v1/sky/radiance: the probe of DESIGN §5.2 answered here, in the
+// server process on one thread (not yet through the farm): "lut" from
+// one-bin tables per wavelength, "path" by the path tracer with standard
+// errors, both bounded so that one request cannot hold a connection thread
+// for long (larger probes: `skyfarm-worker probe`).
+void HttpApi::sky_radiance(const Request& req, Response& res, const ContentReader& reader) {
+  constexpr double kMaxPaths = 4.0e6;    // about 5 s on one core
+  constexpr std::size_t kMaxLutWavelengths = 64;  // one table build each
+  const std::string body = read_body(req, res, reader);
+  check_media_type(req);
+  if (options_.max_json_depth < api::kMaxJsonDepth && json_deeper_than(body, options_.max_json_depth))
+    throw api::ValidationError(
+        {api::FieldError{"", "JSON nested deeper than " + std::to_string(options_.max_json_depth) + " levels", ""}});
+  const api::ProbeRequest request = api::parse_probe_request(std::string_view(body));
+  if (request.method == api::Method::kLut && request.wavelengths_nm.size() > kMaxLutWavelengths)
+    throw api::ValidationError({api::FieldError{"wavelengths_nm", "at most 64 wavelengths with method lut on the server",
+                                                std::to_string(request.wavelengths_nm.size())}});
+  const double paths = static_cast<double>(request.samples) * static_cast<double>(request.directions.size()) *
+                       static_cast<double>(request.wavelengths_nm.size());
+  if (request.method == api::Method::kPath && paths > kMaxPaths)
+    throw api::ValidationError({api::FieldError{
+        "samples", "samples x directions x wavelengths must be at most 4e6 on the server (use skyfarm-worker probe)",
+        std::to_string(request.samples)}});
+  send_json(res, 200, api::answer_probe(request, 1));
+}
 void HttpApi::sky_envmap(const Request& req, Response& res) { sky_->envmap(req, res); }
 
 void HttpApi::openapi(const Request&, Response& res) {

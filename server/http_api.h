@@ -121,6 +121,7 @@ class HttpApi {
   void events(const httplib::Request& req, httplib::Response& res);
   void workers(const httplib::Request& req, httplib::Response& res);
   void sky(const httplib::Request& req, httplib::Response& res);
+  void sky_radiance(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
   void sky_envmap(const httplib::Request& req, httplib::Response& res);
   void openapi(const httplib::Request& req, httplib::Response& res);
   void healthz(const httplib::Request& req, httplib::Response& res);

@@ -432,5 +432,47 @@ TEST(SkyQuery, DefaultsAndCanonicalForm) {
   EXPECT_NEAR(tokyo.table.sun_zenith_deg, 76.2, 0.5);
 }
 
+// POST /v1/sky/radiance (DESIGN §5.2): the probe by the LUT (no standard
+// error) and by the path tracer (with standard errors), agreeing at the
+// zenith; bad bodies and probes too large for the server are 400s naming
+// the field.
+TEST_F(SkyHttpTest, RadianceProbeByLutAndPathTracer) {
+  start();
+  const std::string body = R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180},
+    "directions": [{"zenith_deg": 0, "azimuth_deg": 0}], "wavelengths_nm": [550], "samples": 4096, "seed": 2,
+    "method": ")";
+  auto lut = client().Post("/v1/sky/radiance", body + R"(lut"})", "application/json");
+  auto path = client().Post("/v1/sky/radiance", body + R"(path"})", "application/json");
+  ASSERT_TRUE(lut && path);
+  ASSERT_EQ(lut->status, 200) << lut->body;
+  ASSERT_EQ(path->status, 200) << path->body;
+  const auto a = json_of(lut), b = json_of(path);
+  EXPECT_EQ(a["method"], "lut");
+  EXPECT_TRUE(a["standard_error"].is_null());
+  EXPECT_EQ(b["method"], "path");
+  const double se = b["standard_error"][0][0];
+  EXPECT_GT(se, 0.0);
+  // The production LUT (one 1 nm bin) is within 3 % + 4 standard errors of
+  // the path tracer at the zenith (measured +0.4 % at 550 nm).
+  const double x = a["radiance"][0][0], y = b["radiance"][0][0];
+  EXPECT_NEAR(x, y, 0.03 * y + 4.0 * se);
+
+  auto bad = client().Post("/v1/sky/radiance", R"({"directions": [], "wavelengths_nm": [550]})", "application/json");
+  ASSERT_TRUE(bad);
+  EXPECT_EQ(bad->status, 400);
+  EXPECT_NE(bad->body.find("directions"), std::string::npos) << bad->body;
+  auto huge = client().Post("/v1/sky/radiance",
+                            R"({"sun": {"zenith_deg": 30, "azimuth_deg": 0}, "directions": [{"zenith_deg": 0, "azimuth_deg": 0}],
+                                "wavelengths_nm": [450, 550, 650], "samples": 2000000})",
+                            "application/json");
+  ASSERT_TRUE(huge);
+  EXPECT_EQ(huge->status, 400);
+  EXPECT_NE(huge->body.find("\"samples\""), std::string::npos) << huge->body;
+  auto get = client().Get("/v1/sky/radiance");
+  ASSERT_TRUE(get);
+  EXPECT_EQ(get->status, 405);
+  EXPECT_EQ(get->get_header_value("Allow"), "POST");
+}
+
 }  // namespace
 }  // namespace skyfarm::server
