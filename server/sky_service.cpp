@@ -1,5 +1,7 @@
 #include "server/sky_service.h"
 
+#include "common/sampling/sampler.h"  // fmix64
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,15 +37,6 @@ constexpr double kCieMaxNm = 830.0;
 constexpr int kMinDiskSamples = 64;
 constexpr int kMaxDiskSamples = 512;
 constexpr double kDiskSamplesPerPixel = 256.0;
-
-constexpr std::uint64_t fmix64(std::uint64_t k) {
-  k ^= k >> 33;
-  k *= 0xff51afd7ed558ccdULL;
-  k ^= k >> 33;
-  k *= 0xc4ceb9fe1a85ec53ULL;
-  k ^= k >> 33;
-  return k;
-}
 
 void append_hex(std::string& out, std::uint64_t v) {
   static constexpr char kDigits[] = "0123456789abcdef";

@@ -21,6 +21,7 @@
 
 #include "common/camera/camera.h"
 #include "common/image/exr_writer.h"
+#include "tests/support/coarse_lut.h"
 #include "server/http_api.h"
 #include "tests/server/fake_backend.h"
 
@@ -31,20 +32,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 
 // Coarse tables (fast to build) with the production 16 bins over 360-830 nm.
-LutResolution coarse() {
-  LutResolution r;
-  r.spectral_bins = 16;
-  r.medium_altitude_samples = 256;
-  r.phase_samples = 128;
-  r.transmittance_mu = 64, r.transmittance_r = 32, r.transmittance_steps = 24;
-  r.multiple_scattering_mu_s = 8, r.multiple_scattering_altitude = 8;
-  r.multiple_scattering_directions = 16, r.multiple_scattering_steps = 8;
-  r.ground_irradiance_mu_s = 8, r.ground_irradiance_directions = 16, r.ground_irradiance_steps = 8;
-  r.sky_view_azimuth = 48, r.sky_view_zenith = 36, r.sky_view_steps = 12;
-  r.aerial_azimuth = 4, r.aerial_zenith = 4, r.aerial_slices = 4;
-  r.space_view_steps = 16;
-  return r;
-}
+LutResolution coarse() { return coarse_lut_resolution(16); }
 
 constexpr const char* kLookup = "/v1/sky?sun_zenith=30&sun_azimuth=180&view_zenith=0&view_azimuth=0";
 
