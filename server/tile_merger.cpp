@@ -59,9 +59,9 @@ bool TileMerger::add(const WorkUnit& u, FilmTile film) {
 void TileMerger::merge_ready(int tile_index) {
   const auto t = static_cast<std::size_t>(tile_index);
   auto it = waiting_[t].find(next_index_[t]);
-  if (it == waiting_[t].end() || next_index_[t] / plan_.batches > pass_limit_) return;
+  if (it == waiting_[t].end() || next_index_[t] / plan_.batches >= pass_limit_) return;
   FilmTile& target = tile(tile_index);
-  for (; it != waiting_[t].end() && next_index_[t] / plan_.batches <= pass_limit_;
+  for (; it != waiting_[t].end() && next_index_[t] / plan_.batches < pass_limit_;
        it = waiting_[t].find(next_index_[t])) {
     if (it->second.width() != target.width() || it->second.height() != target.height()) {
       waiting_[t].erase(it);  // cannot happen for results that passed add()
@@ -75,10 +75,10 @@ void TileMerger::merge_ready(int tile_index) {
   persist(tile_index, target);
 }
 
-void TileMerger::set_pass_limit(int last_pass) {
+void TileMerger::set_pass_limit(int passes) {
   const int previous = pass_limit_;
-  pass_limit_ = last_pass;
-  if (last_pass <= previous) return;
+  pass_limit_ = passes;
+  if (passes <= previous) return;
   for (int t = 0; t < plan_.tile_count(); ++t) merge_ready(t);
 }
 

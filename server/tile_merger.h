@@ -44,13 +44,13 @@ class TileMerger {
   // Merged or waiting in memory.
   bool received(const WorkUnit& unit) const;
 
-  // Units of passes after `last_pass` wait in memory instead of being merged
-  // (default: no limit).  Raising the limit merges what became eligible.
+  // Only the first `passes` passes merge; units of later passes wait in
+  // memory (default: no limit).  Raising the limit merges what became eligible.
   // The job service keeps it at (passes complete everywhere) + 1, so that at
   // the moment a pass completes every tile holds exactly that many passes:
   // stopping there (target error reached) gives the same image as a local
   // render stopped after the same pass, whatever the timing.
-  void set_pass_limit(int last_pass);
+  void set_pass_limit(int passes);
   int pass_limit() const { return pass_limit_; }
   // Forgets results waiting in memory (a job stopped early).
   void drop_waiting();

@@ -44,5 +44,35 @@ TEST(TileMerger, TinyMemoryBudgetStillMergesIdentically) {
   EXPECT_TRUE(reloaded.merged(WorkUnit{0, 0, 0}));
 }
 
+// The pass gate of early-stopping jobs: with a limit of k passes, results of
+// pass k wait even when all of them have arrived, so a target-error check
+// sees every pass one at a time (it once let two passes through at once, and
+// a farm job stopped a pass later than the same local render).
+TEST(TileMerger, PassLimitMergesExactlyThatManyPasses) {
+  const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 35, "azimuth_deg": 10},
+    "camera": {"projection": "equirectangular", "width": 32, "height": 16}, "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 64}})");
+  const api::RenderSetup setup = api::make_render_setup(request);
+  ASSERT_GE(setup.plan.passes, 4);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_gate_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  TileMerger merger(setup.plan, dir);
+  merger.set_pass_limit(1);
+  PathCounters counters;
+  for (const auto& u : setup.plan.units()) {
+    if (u.pass >= 3) continue;
+    FilmTile film = renderer.empty_tile(u.tile);
+    renderer.render_unit(u, &film, &counters);
+    merger.add(u, std::move(film));
+  }
+  EXPECT_EQ(merger.complete_passes(), 1);
+  merger.set_pass_limit(2);
+  EXPECT_EQ(merger.complete_passes(), 2);
+  merger.set_pass_limit(3);
+  EXPECT_EQ(merger.complete_passes(), 3);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace skyfarm::server
