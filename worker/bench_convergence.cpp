@@ -186,20 +186,27 @@ double fitted_slope(const std::vector<double>& t, const std::vector<double>& e) 
 int run_bench_convergence(const std::vector<std::string>& args) {
   fs::path dir = "skyfarm-convergence";
   int passes = 32;
+  std::string only;
+  IntegratorOptions options;
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--out" && i + 1 < args.size()) dir = args[++i];
+    else if (args[i] == "--scene" && i + 1 < args.size()) only = args[++i];
+    else if (args[i] == "--forced-segments" && i + 1 < args.size())
+      options.forced_collision_segments = std::atoi(args[++i].c_str());
     else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
     else if (args[i] != "convergence") {
-      std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N]\n";
+      std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
+                   " [--forced-segments K]\n";
       return 2;
     }
   }
   fs::create_directories(dir);
   for (const Scene_& s : kScenes) {
+    if (!only.empty() && only != s.name) continue;
     const std::vector<double> ref = reference(s, passes * 16, dir);
     const auto request = api::parse_render_request(request_json(s, passes * 16, 1));
     const api::RenderSetup setup = api::make_render_setup(request);
-    const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+    const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan, options);
     const std::vector<bool> keep = sky_mask(setup);
     std::vector<double> times, truths, estimates;
     std::ofstream csv(dir / (std::string(s.name) + ".csv"));
@@ -226,6 +233,8 @@ int run_bench_convergence(const std::vector<std::string>& args) {
                                 {"final_true_relative_rms", truths.back()},
                                 {"final_estimated_relative_rms", estimates.back()},
                                 {"seconds", times.back()},
+                                {"samples_per_pixel", passes * 16},
+                                {"forced_collision_segments", options.forced_collision_segments},
                                 {"fitted_slope", fitted_slope(times, truths)},
                                 {"worst_estimate_ratio", worst},
                                 {"efficiency_1_over_err2_time", efficiency}}

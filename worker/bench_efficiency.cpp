@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <iostream>
 #include <optional>
+#include <array>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -19,6 +21,7 @@ struct EfficiencyResult {
   double relative_std_per_path = 0.0;
   double microseconds_per_path = 0.0;
   PathCounters counters;
+  std::vector<std::array<double, 4>> rows;
 };
 
 // Unit vector of (zenith, azimuth) in the observer frame (z up, y north, x east).
@@ -38,8 +41,10 @@ EfficiencyResult measure(double sun_zenith_deg, int samples, const IntegratorOpt
   wl.pdf.fill(1.0);
   EfficiencyResult r;
   double sum_w_var = 0.0, sum_w_L2 = 0.0, sum_w_seconds = 0.0, sum_w = 0.0;
+  std::vector<std::array<double, 4>> rows;  // per zenith row: zenith, w var, w L^2, mean L
   std::uint64_t pixel = 0;
-  for (double zen = 2.5; zen < 180.0; zen += 5.0)
+  for (double zen = 2.5; zen < 180.0; zen += 5.0) {
+    rows.push_back({zen, 0.0, 0.0, 0.0});
     for (double az = 7.5; az < 360.0; az += 15.0, ++pixel) {
       if (std::abs(zen - sun_zenith_deg) < 4.0 && std::abs(az - 180.0) < 10.0) continue;  // the disk
       const double w = std::sin(zen * kPi / 180.0);
@@ -57,7 +62,12 @@ EfficiencyResult measure(double sun_zenith_deg, int samples, const IntegratorOpt
       sum_w_var += w * var;
       sum_w_L2 += w * mean * mean;
       sum_w += w;
+      rows.back()[1] += w * var;
+      rows.back()[2] += w * mean * mean;
+      rows.back()[3] += mean / 24.0;
     }
+  }
+  r.rows = rows;
   r.relative_std_per_path = sum_w_L2 > 0.0 ? std::sqrt(sum_w_var / sum_w_L2) : 0.0;
   r.microseconds_per_path = sum_w_seconds / sum_w / samples * 1e6;
   return r;
@@ -69,6 +79,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
   int samples = 1000;
   std::vector<double> suns;
   IntegratorOptions options;
+  bool breakdown = false;
   for (std::size_t i = 1; i < args.size(); ++i) {  // args[0] is "efficiency"
     if (args[i] == "--samples" && i + 1 < args.size()) {
       samples = std::max(2, std::atoi(args[++i].c_str()));
@@ -76,6 +87,14 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       suns.push_back(std::atof(args[++i].c_str()));
     } else if (args[i] == "--shadow-scale" && i + 1 < args.size()) {
       options.shadow_majorant_scale = std::max(1.0, std::atof(args[++i].c_str()));
+    } else if (args[i] == "--max-depth" && i + 1 < args.size()) {
+      options.max_depth = std::atoi(args[++i].c_str());
+    } else if (args[i] == "--forced-segments" && i + 1 < args.size()) {
+      options.forced_collision_segments = std::atoi(args[++i].c_str());
+    } else if (args[i] == "--camera-collisions" && i + 1 < args.size()) {
+      options.camera_target_collisions = std::atof(args[++i].c_str());
+    } else if (args[i] == "--breakdown") {
+      breakdown = true;
     } else if (args[i] == "--sunlit-segments") {
       options.explicit_single_scattering = true;
     } else {
@@ -96,9 +115,18 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                                 {"relative_std_per_path", r.relative_std_per_path},
                                 {"microseconds_per_path", r.microseconds_per_path},
                                 {"efficiency", rel2 > 0.0 ? 1.0 / (rel2 * r.microseconds_per_path) : 0.0},
-                                {"nonfinite", r.counters.nonfinite}}
+                                {"nonfinite", r.counters.nonfinite},
+                                {"collisions_per_path", static_cast<double>(r.counters.collisions) / static_cast<double>(std::max<std::uint64_t>(1, r.counters.paths))}}
                      .dump()
               << std::endl;
+    if (breakdown) {
+      double v = 0.0;
+      for (const auto& row : r.rows) v += row[1];
+      for (const auto& row : r.rows)
+        std::cout << "  zenith " << row[0] << ": share of variance " << row[1] / v
+                  << ", relative std per path " << (row[2] > 0.0 ? std::sqrt(row[1] / row[2]) : 0.0)
+                  << ", mean " << row[3] << "\n";
+    }
   }
   return 0;
 }

@@ -14,6 +14,13 @@
 // callback stopped the walk.  `majorant_scale` >= 1 inflates the majorants
 // (still bounds, so still unbiased) to place more tentative collisions on a
 // ray, e.g. where each one gathers sunlight (volume_path_integrator.cpp).
+//
+// `forced_tau` > 0 (the hero's scaled majorant optical depth of the whole
+// walk) forces the first tentative collision: its tau* is drawn from the
+// exponential truncated to [0, forced_tau), pdf e^-tau / (1 - e^-forced_tau),
+// so the walk always collides at least once; the caller owns the weight
+// 1 - e^-forced_tau and the walk's collision-free share e^-forced_tau
+// (forced collisions, e.g. Mitsuba's "forced scattering" of camera rays).
 #pragma once
 #include <cmath>
 
@@ -29,10 +36,13 @@ template <class Callback>
 SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorants& shells, const Ray& ray,
                              double t_begin, double t_end,
                              const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
-                             Callback&& callback, double majorant_scale = 1.0) {
+                             Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
-  double tau_target = -std::log1p(-sampler.next());
+  double tau_target = forced_tau > 0.0
+                          // Kept a hair inside the walk so round-off cannot lose the collision.
+                          ? std::min(-std::log1p(sampler.next() * std::expm1(-forced_tau)), forced_tau * (1.0 - 1e-12))
+                          : -std::log1p(-sampler.next());
   ShellTraversal walk(ray, R, shells.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {

@@ -24,12 +24,17 @@ SampledSpectrum clamp_zero(const SampledSpectrum& s) {
   return r;
 }
 
+}  // namespace
+
 // Where a ray is in the atmosphere: [t_begin, t_end], and whether it ends on the ground.
-struct RayExtent {
+struct VolumePathIntegrator::RayExtent {
   bool in_atmosphere = false;
   double t_begin = 0.0, t_end = 0.0;
   bool hits_ground = false;
 };
+
+namespace {
+using RayExtent = VolumePathIntegrator::RayExtent;
 
 RayExtent ray_extent(const Ray& ray, const Atmosphere& atmosphere) {
   RayExtent e;
@@ -100,17 +105,23 @@ SampledSpectrum VolumePathIntegrator::radiance(const Ray& ray, const SampledWave
   return L;
 }
 
-SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledWavelengths& lambda,
+SampledSpectrum VolumePathIntegrator::radiance_unchecked(const Ray& ray, const SampledWavelengths& lambda,
                                                          Sampler& sampler, PathCounters* counters) const {
+  const PathCoefficients path = scene_.medium().path_coefficients(lambda, &scene_.sun());
+  const PathPhases phases = scene_.medium().phases(lambda);
+  const PathContext c{lambda, path, phases, sampler, counters};
+  return trace(ray, PathState{}, 0, c);
+}
+
+// The path from `ray` on, `st` its state after `depth` vertices.
+SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, const PathContext& c) const {
   const AtmosphereMedium& medium = scene_.medium();
   const Atmosphere& atmosphere = scene_.atmosphere();
-  const Sun& sun = scene_.sun();
-  const PathCoefficients path = medium.path_coefficients(lambda, &sun);
-  const auto& bins = path.bins;
-  const PathPhases phases = medium.phases(lambda);
-
-  SampledSpectrum L(0.0), beta(1.0), r_u(1.0), r_l(1.0);
-  bool mis_with_sun = false;  // the previous vertex sampled the sun (NEE)
+  const PathCoefficients& path = c.path;
+  const PathPhases& phases = c.phases;
+  Sampler& sampler = c.sampler;
+  PathCounters* counters = c.counters;
+  SampledSpectrum L(0.0);
   // With the sunlit-segment estimator, the sun's light scattered in the
   // medium comes from sunlit_single_scattering on every segment of the path
   // (camera ray and every ray after a vertex), weighted by the path's
@@ -119,20 +130,47 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
   // seen right after one (that light is the segment estimator's).  Ground
   // vertices keep their NEE with MIS.
   const bool explicit_single = options_.explicit_single_scattering && scene_.sun_enabled;
-  bool last_vertex_in_medium = false;  // the ray leaves a medium scattering vertex
   MediumPoint mp;
 
-  for (int depth = 0;; ++depth) {
+  for (;; ++depth) {
     const RayExtent extent = ray_extent(ray, atmosphere);
     bool scattered = false, absorbed = false;
     // --- The sun scattered once along this segment, sampled where it is lit.
     if (explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
-      L += beta * sunlit_single_scattering(ray, extent.t_begin, extent.t_end, lambda, path, phases, sampler,
-                                           counters) *
-           (1.0 / r_u.average());
+      L += st.beta *
+           sunlit_single_scattering(ray, extent.t_begin, extent.t_end, c.lambda, path, phases, sampler, counters) *
+           (1.0 / st.r_u.average());
 
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
+      const double scale = depth == 0 ? camera_majorant_scale(ray, extent.t_begin, extent.t_end, path.bins) : 1.0;
+      double forced_tau = 0.0;
+      if (depth < options_.forced_collision_segments) {
+        // --- Forced first collision on the first segments of the path (the
+        // camera ray, the ray after the first vertex).  Their tentative
+        // collisions split into "none" (weight T_maj of the whole segment,
+        // with probability 1 for every hero: r_u unchanged, and r_l, the
+        // sun-sampling technique's pdf over the actual one, times T_maj) and
+        // "at least one" (the first drawn from the truncated exponential: the
+        // actual pdf, and each wavelength's had it been the hero, divided by
+        // 1 - T_maj).  Both are followed, so these rays always gather the
+        // sun in the air and scatter on, instead of about 1 time in 10 in a
+        // clear noon sky: the main source of multiple-scattering noise.
+        const SampledSpectrum tau = majorant_optical_depth(medium, medium.fine_shells(), ray, extent.t_begin,
+                                                           extent.t_end, path.bins) * scale;
+        PathState none = st;
+        none.beta *= exp_neg(tau);
+        none.r_l *= exp_neg(tau);
+        Ray next = ray;
+        if (finish_segment(extent, c, depth, &next, &none, &L)) L += trace(next, none, depth + 1, c);
+        SampledSpectrum p_some;
+        for (int i = 0; i < kWavelengthsPerPath; ++i) p_some[i] = -std::expm1(-tau[i]);
+        if (!(p_some[0] > 0.0)) return L;
+        st.beta *= p_some[0];
+        st.r_l *= p_some[0];
+        st.r_u *= safe_div(SampledSpectrum(p_some[0]), p_some);
+        forced_tau = tau[0];
+      }
       const SampledSpectrum T_maj = sample_t_maj(
           medium, medium.fine_shells(), ray, extent.t_begin, extent.t_end, path, sampler, mp,
           [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
@@ -143,11 +181,11 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             // real-scattering branch (throughput and r_u of that branch).
             if (scene_.sun_enabled && p_scatter > 0.0 && !explicit_single) {
               const double pdf = T_maj_seg[0] * mp.sigma_s[0];
-              const SampledSpectrum beta_s = beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              const SampledSpectrum r_u_s = r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              const SampledSpectrum beta_s = st.beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              const SampledSpectrum r_u_s = st.r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
               if (!beta_s.is_zero() && !r_u_s.is_zero()) {
                 Vertex v{p, ray.d, false, {}, &mp, &phases, &path, beta_s * p_scatter, r_u_s};
-                L += sample_sun(v, lambda, sampler, counters);
+                L += sample_sun(v, c.lambda, sampler, counters);
               }
             }
             const double u = sampler.next();
@@ -158,108 +196,132 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(Ray ray, const SampledW
             if (u < p_absorb + p_scatter) {
               // Real scattering: pdf of this event for the hero, T_maj sigma_s.
               const double pdf = T_maj_seg[0] * mp.sigma_s[0];
-              beta *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              r_u *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              if (beta.is_zero() || r_u.is_zero()) {
+              st.beta *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              st.r_u *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+              if (st.beta.is_zero() || st.r_u.is_zero()) {
                 absorbed = true;
                 return false;
               }
-              // Continue along a direction from the mixture phase function:
-              // pick a constituent by its share of sigma_s at the hero
-              // wavelength, then sample its phase function.
-              double pick = sampler.next() * mp.sigma_s[0];
-              int s = 0;
-              while (s + 1 < phases.count() && pick >= mp.sigma_s_c[static_cast<std::size_t>(s)][0]) {
-                pick -= mp.sigma_s_c[static_cast<std::size_t>(s)][0];
-                ++s;
-              }
-              const double mu = clamp_cos(phases.sample_cos_theta(s, sampler.next()));
-              const double phi = 2.0 * kPi * sampler.next();
-              const double sin_theta = safe_sqrt(1.0 - mu * mu);
-              const glm::dvec3 wi = glm::normalize(
-                  Frame(ray.d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
-              const SampledSpectrum p_mix = mixture_phase(mp, phases, mu);
-              const double pdf_dir = p_mix[0];
-              if (!(pdf_dir > 0.0)) {
-                absorbed = true;
-                return false;
-              }
-              const SampledSpectrum ratio = p_mix * (1.0 / pdf_dir);
-              r_l = r_u * (1.0 / pdf_dir);
-              beta *= ratio;
-              r_u *= ratio;
-              ray = Ray{p, wi};
-              scattered = true;
+              scattered = scatter_in_medium(p, mp, phases, sampler, &ray, &st);
+              absorbed = !scattered;
               return false;
             }
             // Null collision.
             const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
             const double pdf = T_maj_seg[0] * sigma_n[0];
             if (!(pdf > 0.0)) {
-              beta = SampledSpectrum(0.0);
+              st.beta = SampledSpectrum(0.0);
               return false;
             }
-            beta *= T_maj_seg * sigma_n * (1.0 / pdf);
-            r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
-            r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
-            return !beta.is_zero() && !r_u.is_zero();
+            st.beta *= T_maj_seg * sigma_n * (1.0 / pdf);
+            st.r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
+            st.r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
+            return !st.beta.is_zero() && !st.r_u.is_zero();
           },
-          depth == 0 ? camera_majorant_scale(ray, extent.t_begin, extent.t_end, bins) : 1.0);
-      if (absorbed || beta.is_zero()) return L;
+          scale, forced_tau);
+      if (absorbed || st.beta.is_zero()) return L;
       if (!scattered) {
         const double T0 = T_maj[0];
-        beta *= T_maj * (1.0 / T0);
-        r_u *= T_maj * (1.0 / T0);
-        r_l *= T_maj * (1.0 / T0);
+        st.beta *= T_maj * (1.0 / T0);
+        st.r_u *= T_maj * (1.0 / T0);
+        st.r_l *= T_maj * (1.0 / T0);
       }
     }
-
     if (!scattered) {
-      if (extent.hits_ground) {
-        // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
-        const glm::dvec3 n = glm::normalize(ray.at(extent.t_end));
-        const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
-        Vertex v{p, ray.d, true, n, nullptr, nullptr, &path, beta, r_u};
-        if (scene_.sun_enabled) L += sample_sun(v, lambda, sampler, counters);
-        double pdf = 0.0;
-        const glm::dvec3 wi = atmosphere.ground().sample_direction(n, sampler.next(), sampler.next(), &pdf);
-        if (!(pdf > 0.0)) return L;
-        // f cos / pdf = rho for Lambert (pdf = cos / pi).
-        beta *= path.ground_albedo;
-        r_l = r_u * (1.0 / pdf);
-        ray = Ray{p, wi};
+      if (!finish_segment(extent, c, depth, &ray, &st, &L)) return L;
+      continue;
+    }
+    st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
+    st.last_vertex_in_medium = true;
+    if (!survives(&st, depth, sampler, counters)) return L;
+  }
+}
+
+// A real scattering in the medium at p: the next direction from the mixture
+// phase function (a constituent picked by its share of sigma_s at the hero
+// wavelength, then its phase function sampled); false if it has no pdf.
+bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPoint& mp, const PathPhases& phases,
+                                             Sampler& sampler, Ray* ray, PathState* st) const {
+  double pick = sampler.next() * mp.sigma_s[0];
+  int s = 0;
+  while (s + 1 < phases.count() && pick >= mp.sigma_s_c[static_cast<std::size_t>(s)][0]) {
+    pick -= mp.sigma_s_c[static_cast<std::size_t>(s)][0];
+    ++s;
+  }
+  const double mu = clamp_cos(phases.sample_cos_theta(s, sampler.next()));
+  const double phi = 2.0 * kPi * sampler.next();
+  const double sin_theta = safe_sqrt(1.0 - mu * mu);
+  const glm::dvec3 wi =
+      glm::normalize(Frame(ray->d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
+  const SampledSpectrum p_mix = mixture_phase(mp, phases, mu);
+  const double pdf_dir = p_mix[0];
+  if (!(pdf_dir > 0.0)) return false;
+  const SampledSpectrum ratio = p_mix * (1.0 / pdf_dir);
+  st->r_l = st->r_u * (1.0 / pdf_dir);
+  st->beta *= ratio;
+  st->r_u *= ratio;
+  *ray = Ray{p, wi};
+  return true;
+}
+
+// The end of a segment the path crossed without scattering: space (the sun
+// disk, with MIS if the last vertex sampled it, and the environment; the
+// path ends: false) or the ground (sun NEE, then a cosine-weighted bounce:
+// *ray and *st become the bounced path's, true if it goes on).  Light
+// gathered is added to *L.
+bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray,
+                                          PathState* st, SampledSpectrum* L) const {
+  const Sun& sun = scene_.sun();
+  const PathCoefficients& path = c.path;
+  if (st->beta.is_zero()) return false;
+  if (!extent.hits_ground) {
+    const bool sun_is_segment_estimators = options_.explicit_single_scattering && st->last_vertex_in_medium;
+    if (scene_.sun_enabled && sun.contains(ray->d) && !sun_is_segment_estimators) {
+      const SampledSpectrum& Le = path.sun_radiance;
+      if (!st->mis_with_sun) {
+        *L += st->beta * Le * (1.0 / st->r_u.average());
       } else {
-        // --- Escaped: the sun disk (with MIS if the last vertex sampled it) and the environment.
-        if (scene_.sun_enabled && sun.contains(ray.d) && !(explicit_single && last_vertex_in_medium)) {
-          const SampledSpectrum& Le = path.sun_radiance;
-          if (!mis_with_sun) {
-            L += beta * Le * (1.0 / r_u.average());
-          } else {
-            r_l *= sun.pdf(ray.d);
-            L += beta * Le * (1.0 / (r_u + r_l).average());
-          }
-        }
-        if (scene_.environment_radiance > 0.0)
-          L += beta * scene_.environment_radiance * (1.0 / r_u.average());
-        return L;
+        const SampledSpectrum r_l = st->r_l * sun.pdf(ray->d);
+        *L += st->beta * Le * (1.0 / (st->r_u + r_l).average());
       }
     }
-    mis_with_sun = scene_.sun_enabled && !sun.is_point();
-    last_vertex_in_medium = scattered;
-
-    // --- Russian roulette on the MIS-normalised throughput.
-    if (beta.is_zero()) return L;
-    const SampledSpectrum rr_beta = beta * (1.0 / r_u.average());
-    if (depth + 1 >= options_.rr_start_depth && rr_beta.max() < 1.0) {
-      const double q = std::max(0.0, 1.0 - rr_beta.max());
-      if (sampler.next() < q) return L;
-      beta *= 1.0 / (1.0 - q);
-    }
-    if (depth + 1 >= options_.max_depth) {
-      ++counters->depth_limit;
-      return L;
-    }
+    if (scene_.environment_radiance > 0.0)
+      *L += st->beta * scene_.environment_radiance * (1.0 / st->r_u.average());
+    return false;
   }
+  // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
+  const Atmosphere& atmosphere = scene_.atmosphere();
+  const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
+  const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
+  Vertex v{p, ray->d, true, n, nullptr, nullptr, &path, st->beta, st->r_u};
+  if (scene_.sun_enabled) *L += sample_sun(v, c.lambda, c.sampler, c.counters);
+  double pdf = 0.0;
+  const glm::dvec3 wi = atmosphere.ground().sample_direction(n, c.sampler.next(), c.sampler.next(), &pdf);
+  if (!(pdf > 0.0)) return false;
+  // f cos / pdf = rho for Lambert (pdf = cos / pi).
+  st->beta *= path.ground_albedo;
+  st->r_l = st->r_u * (1.0 / pdf);
+  st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
+  st->last_vertex_in_medium = false;
+  *ray = Ray{p, wi};
+  return survives(st, depth, c.sampler, c.counters);
+}
+
+// Russian roulette on the MIS-normalised throughput after the vertex at
+// `depth`, and the depth cap; false ends the path.
+bool VolumePathIntegrator::survives(PathState* st, int depth, Sampler& sampler, PathCounters* counters) const {
+  if (st->beta.is_zero()) return false;
+  const SampledSpectrum rr_beta = st->beta * (1.0 / st->r_u.average());
+  if (depth + 1 >= options_.rr_start_depth && rr_beta.max() < 1.0) {
+    const double q = std::max(0.0, 1.0 - rr_beta.max());
+    if (sampler.next() < q) return false;
+    st->beta *= 1.0 / (1.0 - q);
+  }
+  if (depth + 1 >= options_.max_depth) {
+    ++counters->depth_limit;
+    return false;
+  }
+  return true;
 }
 
 // Next-event estimation of the sun from a vertex (pbrt-v4 SampleLd, with

@@ -65,6 +65,11 @@ struct IntegratorOptions {
   // along long lit segments are heavy-tailed; for zenith views at twilight it
   // gains 10x.
   bool explicit_single_scattering = false;
+  // Forced collisions on the path's first segments (0: none, 1: the camera
+  // ray, 2: and the ray after the first vertex): both "no tentative
+  // collision along the whole segment" (weight T_maj) and "at least one"
+  // (the first drawn within the segment) are followed (see the .cpp).
+  int forced_collision_segments = 2;
 };
 
 // Counters a renderer sums over its paths.
@@ -101,8 +106,34 @@ class VolumePathIntegrator {
 
  private:
   struct Vertex;
-  SampledSpectrum radiance_unchecked(Ray ray, const SampledWavelengths& lambda, Sampler& sampler,
+  // What a path carries between vertices: throughput, spectral-MIS ratios
+  // (r_u unidirectional, r_l light sampling; pbrt-v4), and how it got here.
+  struct PathState {
+    SampledSpectrum beta{1.0}, r_u{1.0}, r_l{1.0};
+    bool mis_with_sun = false;           // the previous vertex sampled the sun (NEE)
+    bool last_vertex_in_medium = false;  // the ray leaves a medium scattering vertex
+  };
+  // What stays fixed along one path.
+  struct PathContext {
+    const SampledWavelengths& lambda;
+    const PathCoefficients& path;
+    const PathPhases& phases;
+    Sampler& sampler;
+    PathCounters* counters;
+  };
+
+ public:
+  struct RayExtent;
+
+ private:
+  SampledSpectrum radiance_unchecked(const Ray& ray, const SampledWavelengths& lambda, Sampler& sampler,
                                      PathCounters* counters) const;
+  SampledSpectrum trace(Ray ray, PathState st, int depth, const PathContext& c) const;
+  bool scatter_in_medium(const glm::dvec3& p, const MediumPoint& mp, const PathPhases& phases, Sampler& sampler,
+                         Ray* ray, PathState* st) const;
+  bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
+                      SampledSpectrum* L) const;
+  bool survives(PathState* st, int depth, Sampler& sampler, PathCounters* counters) const;
   SampledSpectrum sunlit_single_scattering(const Ray& ray, double t0, double t1, const SampledWavelengths& lambda,
                                            const PathCoefficients& path, const PathPhases& phases, Sampler& sampler,
                                            PathCounters* counters) const;

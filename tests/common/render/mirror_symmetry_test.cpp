@@ -46,6 +46,10 @@ TEST(MirrorSymmetry, HalfRenderedHalfMirroredAndPhysicallyRight) {
   const LocalRenderResult rf = render_image(full, &reference, 2);
   EXPECT_LT(rm.counters.paths * 10, rf.counters.paths * 6) << "about half the paths";
 
+  // The sun (zenith 60 deg, at the view's centre) sits on the column
+  // boundary at about row 21: its pixels, a few sun-disk hits each at
+  // 32 spp, are left out of the comparison of the halves.
+  const auto near_sun = [](int x, int y) { return x >= 60 && std::abs(y - 21) <= 3; };
   double left = 0.0, right_mirrored = 0.0, right_rendered = 0.0;
   for (int y = 0; y < 64; ++y)
     for (int x = 0; x < 64; ++x) {
@@ -53,6 +57,7 @@ TEST(MirrorSymmetry, HalfRenderedHalfMirroredAndPhysicallyRight) {
       ASSERT_EQ(mirrored.rgb(x, y), reference.rgb(x, y)) << x << "," << y;
       // Right half: the exact mirror image.
       ASSERT_EQ(mirrored.rgb(127 - x, y), mirrored.rgb(x, y));
+      if (near_sun(x, y)) continue;
       left += reference.luminance(x, y);
       right_mirrored += mirrored.luminance(127 - x, y);
       right_rendered += reference.luminance(127 - x, y);
