@@ -150,6 +150,9 @@ void WebDriver::stop() {
       std::this_thread::sleep_for(20ms);
     ::kill(-pid_, SIGKILL);  // whatever is left of the group (a hung browser)
     ::waitpid(pid_, &status, 0);
+    // The browser's processes are not our children: wait until the group is gone.
+    const auto gone_by = std::chrono::steady_clock::now() + 3s;
+    while (::kill(-pid_, 0) == 0 && std::chrono::steady_clock::now() < gone_by) std::this_thread::sleep_for(20ms);
     pid_ = 0;
   }
   client_.reset();
