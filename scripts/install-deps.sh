@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages skyfarm builds and runs with, when missing.
 # Safe to run again: it only calls apt-get when something is not installed.
+#   --browser   also headless Chromium and its WebDriver (chromium,
+#               chromium-driver) for the web page's test (scripts/test.sh)
 set -euo pipefail
 
 packages=(
@@ -9,6 +11,12 @@ packages=(
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+for arg in "$@"; do
+  case $arg in
+    --browser) packages+=(chromium chromium-driver) ;;
+    *) echo "install-deps.sh: unknown option $arg (known: --browser)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

@@ -44,5 +44,6 @@ for request in "$root"/api/examples/demo_*.json; do
   echo "  wrote $out/$name.exr and $out/$name.png"
 done
 
-echo "skyfarm is serving on http://$listen (API under /v1, see /v1/openapi.yaml); Ctrl-C to stop."
+echo "skyfarm is serving on http://$listen: the web page at http://$listen/, the API under /v1"
+echo "(see /v1/openapi.yaml); Ctrl-C to stop."
 wait $server

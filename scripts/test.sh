@@ -3,7 +3,7 @@
 # Release and runs every test (CTest, all registered via gtest_discover_tests).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/scripts/install-deps.sh"
+"$root/scripts/install-deps.sh" --browser   # the web page's test drives headless Chromium
 "$root/scripts/build.sh"
 build=${SKYFARM_BUILD_DIR:-$root/build}
 cd "$build"

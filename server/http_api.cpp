@@ -15,6 +15,7 @@
 #include "server/http_openapi.h"
 #include "server/http_problem.h"
 #include "server/http_sky.h"
+#include "server/http_web.h"
 #include "api/probe_answer.h"
 
 namespace skyfarm::server {
@@ -75,7 +76,7 @@ std::optional<std::string_view> allowed_methods(std::string_view path) {
   if (path == "/v1/renders") return "GET, HEAD, POST";
   if (path == "/v1/sky/radiance") return "POST";
   if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
-      path == "/v1/sky" || path == "/v1/sky/envmap.exr")
+      path == "/v1/sky" || path == "/v1/sky/envmap.exr" || find_web_file(path))
     return "GET, HEAD";
   constexpr std::string_view kPrefix = "/v1/renders/";
   if (!path.starts_with(kPrefix)) return std::nullopt;
@@ -261,7 +262,8 @@ void HttpApi::configure_server(httplib::Server& server) {
 }
 
 bool HttpApi::admitted(const Request& req, Response& res) const {
-  if (!options_.token || req.path == "/healthz" || authorized(req)) return true;
+  // The web page's files are public; the page sends the token on its API calls.
+  if (!options_.token || req.path == "/healthz" || find_web_file(req.path) || authorized(req)) return true;
   run_guarded(req, res, [&] { answer_unauthorized(req, res); });
   return false;
 }
@@ -339,6 +341,8 @@ void HttpApi::add_routes(httplib::Server& server) {
   server.Get(R"(/v1/openapi\.yaml)", guarded(&HttpApi::openapi));
   server.Get("/healthz", guarded(&HttpApi::healthz));
   server.Get("/metrics", guarded(&HttpApi::metrics));
+  server.Get("/", guarded(&HttpApi::web_file));
+  server.Get(kWebAssetRoute, guarded(&HttpApi::web_file));
 }
 
 void HttpApi::add_fallbacks(httplib::Server& server) {
@@ -503,6 +507,8 @@ void HttpApi::openapi(const Request&, Response& res) {
   res.status = 200;
   res.set_content(text.data(), text.size(), kOpenApiContentType);
 }
+
+void HttpApi::web_file(const Request& req, Response& res) { serve_web_file(req, res); }
 
 void HttpApi::healthz(const Request&, Response& res) { send_json(res, 200, {{"status", "ok"}}); }
 

@@ -17,6 +17,7 @@
 //   GET    /v1/sky/envmap.exr?...       a cached lat-long environment map; both with strong
 //                                       ETags, If-None-Match -> 304 (server/http_sky.h)
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)
+//   GET    /, /web/<file>               the web page (server/http_web.h); public even with a token
 //   GET    /healthz                     {"status": "ok"}; never needs the token
 //   GET    /metrics                     Prometheus text (text/plain; version=0.0.4)
 // Job ids are 1-64 of [A-Za-z0-9_-] (else 400, before the backend sees them).
@@ -31,9 +32,9 @@
 // stderr); 503 too many event streams (Retry-After); 507 data directory not
 // writable.
 //
-// Options: `token` (bearer token on every route but /healthz; compared in
-// constant time), `max_body_bytes`, `max_json_depth` (stricter than the
-// parser's own 32 when lower), `max_concurrent_streams`, `sse_keepalive`,
+// Options: `token` (bearer token on every route but /healthz and the web
+// page; compared in constant time), `max_body_bytes`, `max_json_depth`
+// (stricter than the parser's own 32 when lower), `max_concurrent_streams`, `sse_keepalive`,
 // `http_threads` (httplib's pool), `on_response` (access log hook), `sky`
 // (the sky look-ups' caches, shared; a default one when null).
 //
@@ -124,6 +125,7 @@ class HttpApi {
   void sky_radiance(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
   void sky_envmap(const httplib::Request& req, httplib::Response& res);
   void openapi(const httplib::Request& req, httplib::Response& res);
+  void web_file(const httplib::Request& req, httplib::Response& res);
   void healthz(const httplib::Request& req, httplib::Response& res);
   void metrics(const httplib::Request& req, httplib::Response& res);
   // Unmatched paths and methods: 404, or 405 with Allow (204 for OPTIONS).
