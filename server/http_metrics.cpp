@@ -156,6 +156,10 @@ void append_sky_cache_metrics(std::string& out, const SkyCacheStats& s) {
   }
   header(out, "skyfarm_sky_cache_build_seconds_total", "counter", "Seconds spent building sky tables.");
   sample(out, "skyfarm_sky_cache_build_seconds_total", "cache=\"table\"", format_value(s.table_build_seconds));
+  header(out, "skyfarm_sky_cache_sun_only_builds_total", "counter",
+         "Sky tables built for a new sun from cached atmosphere tables (LutSky::with_sun).");
+  sample(out, "skyfarm_sky_cache_sun_only_builds_total", "cache=\"table\"",
+         std::to_string(s.table_sun_only_builds));
 }
 
 }  // namespace skyfarm::server

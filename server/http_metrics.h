@@ -39,7 +39,9 @@ std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter
 //   skyfarm_sky_cache_hits_total, _misses_total, _waits_total (waited for a
 //   build in progress), _builds_total, _build_failures_total, _evictions_total
 //   (counters), skyfarm_sky_cache_bytes, _entries, _capacity_bytes (gauges),
-//   and skyfarm_sky_cache_build_seconds_total{cache="table"} (counter).
+//   skyfarm_sky_cache_build_seconds_total{cache="table"} and
+//   skyfarm_sky_cache_sun_only_builds_total{cache="table"} (tables made for a
+//   new sun from cached atmosphere tables; counters).
 struct SkyCacheStats;
 void append_sky_cache_metrics(std::string& out, const SkyCacheStats& stats);
 

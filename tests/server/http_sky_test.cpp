@@ -365,7 +365,15 @@ TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
     EXPECT_NE(m->body.find(expected), std::string::npos) << expected << " in\n" << m->body;
   EXPECT_NE(m->body.find("skyfarm_sky_cache_bytes{cache=\"table\"} " + std::to_string(service_->stats().table_bytes)),
             std::string::npos);
+  EXPECT_NE(m->body.find("skyfarm_sky_cache_sun_only_builds_total{cache=\"table\"} 0\n"), std::string::npos);
+  // Another sun of the same atmosphere: its tables come from the cached ones.
+  ASSERT_EQ(c.Get("/v1/sky?sun_zenith=60&sun_azimuth=90&view_zenith=0&view_azimuth=0")->status, 200);
+  m = c.Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("skyfarm_sky_cache_sun_only_builds_total{cache=\"table\"} 1\n"), std::string::npos)
+      << m->body;
 }
+
 
 TEST_F(SkyHttpTest, TokenMakesAnswersPrivateAndWrongMethodsAre405) {
   start("tok");
