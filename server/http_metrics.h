@@ -45,4 +45,12 @@ std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter
 struct SkyCacheStats;
 void append_sky_cache_metrics(std::string& out, const SkyCacheStats& stats);
 
+// The farm's probes (server/probe_service.h): skyfarm_probes_total{outcome=
+// "done"|"failed"|"timeout"|"no_workers"|"refused"}, skyfarm_probe_units_
+// dispatched_total, _units_done_total, _unit_failures_total,
+// _unit_requeues_total, _paths_total (counters), skyfarm_probes_active,
+// skyfarm_probe_queue_units, _units_in_flight, _workers (gauges).
+struct ProbeStats;
+void append_probe_metrics(std::string& out, const ProbeStats& stats);
+
 }  // namespace skyfarm::server

@@ -10,9 +10,11 @@ const char* const kServerUsage =
     "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
+    "                      [--probe-timeout SECONDS (default 120)]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
-    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES).\n"
+    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT).\n"
+    "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
 
 namespace {
@@ -30,7 +32,10 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"},
                            {"--max-active-jobs", "SKYFARM_MAX_ACTIVE_JOBS"},
                            {"--max-queue-units", "SKYFARM_MAX_QUEUE_UNITS"},
-                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"}};
+                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"},
+                           {"--probe-timeout", "SKYFARM_PROBE_TIMEOUT"}};
+
+constexpr double kMaxProbeTimeoutS = 3600.0;
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
@@ -38,6 +43,21 @@ long long whole_number(const std::string& value, long long lo, long long hi) {
   const long long n = std::stoll(value, &used);
   if (used != value.size() || n < lo || n > hi) throw std::invalid_argument("range");
   return n;
+}
+
+// The flags whose error says the expected range.
+std::string set_sizes_and_timeouts(const std::string& flag, const std::string& value, ServerOptions* o) {
+  try {
+    if (flag == "--probe-timeout") {
+      std::size_t used = 0;
+      const double s = std::stod(value, &used);
+      if (used != value.size() || !(s > 0.0 && s <= kMaxProbeTimeoutS)) throw std::invalid_argument("range");
+      o->probe_timeout_s = s;
+    }
+  } catch (const std::exception&) {
+    return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
+  }
+  return "";
 }
 
 std::string set(const std::string& flag, const std::string& value, ServerOptions* o) {
@@ -70,7 +90,7 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
   } catch (const std::exception&) {
     return flag + ": invalid value '" + value + "'";
   }
-  return "";
+  return set_sizes_and_timeouts(flag, value, o);
 }
 
 }  // namespace

@@ -42,5 +42,20 @@ TEST(ServerOptions, BadValuesNameTheFlag) {
   ::unsetenv("SKYFARM_UNIT_TIMEOUT");
 }
 
+// The probe timeout: default, flag, and bad values refused naming the flag
+// and the range.
+TEST(ServerOptions, ProbeTimeout) {
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({}, &o), "");
+  EXPECT_EQ(o.probe_timeout_s, 120.0);
+  ASSERT_EQ(parse_server_options({"--probe-timeout", "2.5"}, &o), "");
+  EXPECT_EQ(o.probe_timeout_s, 2.5);
+  ServerOptions bad;
+  EXPECT_EQ(parse_server_options({"--probe-timeout", "0"}, &bad),
+            "--probe-timeout: invalid value '0' (seconds in (0, 3600])");
+  EXPECT_EQ(parse_server_options({"--probe-timeout", "1e9"}, &bad),
+            "--probe-timeout: invalid value '1e9' (seconds in (0, 3600])");
+}
+
 }  // namespace
 }  // namespace skyfarm::server
