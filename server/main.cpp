@@ -83,6 +83,10 @@ int main(int argc, char** argv) {
     http_options.max_body_bytes = static_cast<std::size_t>(options.max_body_bytes);
     http_options.probes = probes;
     http_options.probe_timeout = std::chrono::milliseconds(static_cast<long long>(options.probe_timeout_s * 1000.0));
+    SkyServiceOptions sky;
+    sky.table_cache_bytes = static_cast<std::size_t>(options.sky_cache_mb) << 20;
+    sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
+    http_options.sky = std::make_shared<SkyService>(sky);
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);

@@ -132,5 +132,15 @@ TEST(ProbeFarm, SlowProbeIs504AndTheWorkersAreFreedForTheNext) {
   EXPECT_EQ(next->status, 200) << next->body;
 }
 
+TEST(ProbeFarm, BadCacheFlagExitsWithTwoNamingTheFlag) {
+  const fs::path dir = fresh_dir("flag");
+  const std::string cmd = std::string(SKYFARM_SERVER_BINARY) + " --sky-cache-mb lots --data-dir " +
+                          (dir / "data").string() + " > " + (dir / "out.txt").string() + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 2);
+  EXPECT_NE(testing::read_text(dir / "out.txt").find("--sky-cache-mb: invalid value 'lots'"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace skyfarm
