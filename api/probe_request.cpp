@@ -7,7 +7,7 @@ namespace {
 
 constexpr std::size_t kMaxDirections = 10000;
 constexpr std::size_t kMaxWavelengths = 10000;
-constexpr int kMaxSamples = 1 << 24;
+constexpr int kMaxSamples = 1000000000;  // per direction and wavelength (the server caps the whole probe too)
 
 // --- "directions" (required): 1..10000 {zenith_deg, azimuth_deg}, both required.
 void read_directions(const Fields& top, std::vector<ProbeDirection>& out) {

@@ -154,6 +154,7 @@ Json header_of(const HeartbeatMsg& m) {
 Json header_of(const UnitMsg& m) {
   Json h = write_unit_ref(m.unit);
   h["request"] = m.request;
+  if (m.kind == UnitKind::kProbe) h["kind"] = "probe";  // absent: render (the version 1 UNIT)
   return h;
 }
 Json header_of(const ResultMsg& m) {
@@ -204,6 +205,9 @@ UnitMsg read_unit(const Json& h) {
   UnitMsg m;
   m.unit = read_unit_ref(h);
   m.request = get_string(h, "request", kMaxHeaderBytes);
+  const std::string kind = get_string(h, "kind", 16, false);
+  if (kind == "probe") m.kind = UnitKind::kProbe;
+  else if (!kind.empty() && kind != "render") fail("\"kind\" must be render or probe");
   return m;
 }
 ResultMsg read_result(const Json& h, const std::string& payload) {

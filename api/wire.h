@@ -16,14 +16,21 @@
 //                                heartbeat_ms?, token?
 //   HEARTBEAT   both ways        heartbeat_ms? (sender's interval),            -
 //                                draining? (worker: send no more units)
-//   UNIT        server -> worker job, tile, batch, pass, attempt, request      -
-//                                (request: api::canonical_text of the job)
+//   UNIT        server -> worker job, tile, batch, pass, attempt, request,     -
+//                                kind? (request: api::canonical_text of the job)
 //   RESULT      worker -> server job, tile, batch, pass, attempt, paths,        FilmTile bytes
 //                                seconds
 //   FAILED      worker -> server job, tile, batch, pass, attempt, message       -
 //   CANCEL      server -> worker attempt                                        -
 //   DISCONNECT  both ways        reason?, fatal? (server: do not reconnect)     -
 //   REREGISTER  server -> worker -  (the server does not know this peer: READY) -
+//
+// Unit kinds: "render" (kind absent) is a render unit (tile, batch, pass of
+// the job's RenderPlan) answered with FilmTile bytes.  "probe" is a unit of a
+// radiance probe (request: the ProbeRequest's canonical text; tile = the
+// unit's index in api::probe_plan, batch = pass = 0) answered with
+// ProbeUnitSums bytes (common/render/probe_units.h); the server sends them
+// only to workers whose READY capabilities hold "probe": kProbeUnitsVersion.
 //
 // Versioning: READY carries kProtocolVersion; the server refuses another
 // version with a fatal DISCONNECT.  Decoding is strict: an unknown command, a
@@ -46,6 +53,8 @@
 namespace skyfarm::api {
 
 inline constexpr int kProtocolVersion = 1;
+// The READY capability "probe" of a worker that runs probe units.
+inline constexpr int kProbeUnitsVersion = 1;
 
 // Bounds on what a peer may send (a header is small JSON; the request text of
 // a unit may carry tables such as sun.irradiance).
@@ -94,9 +103,12 @@ struct UnitRef {
   bool operator==(const UnitRef&) const = default;
 };
 
+enum class UnitKind { kRender, kProbe };
+
 struct UnitMsg {
   UnitRef unit;
   std::string request;  // canonical request text
+  UnitKind kind = UnitKind::kRender;
   bool operator==(const UnitMsg&) const = default;
 };
 
@@ -104,7 +116,7 @@ struct ResultMsg {
   UnitRef unit;
   std::uint64_t paths = 0;
   double seconds = 0.0;
-  std::string film_tile;  // FilmTile::serialize() bytes, not checked here
+  std::string film_tile;  // FilmTile::serialize() (probe: ProbeUnitSums::serialize()) bytes, not checked here
   bool operator==(const ResultMsg&) const = default;
 };
 

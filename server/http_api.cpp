@@ -13,6 +13,7 @@
 #include "api/render_request.h"
 #include "server/http_checks.h"
 #include "server/http_openapi.h"
+#include "server/http_probe.h"
 #include "server/http_problem.h"
 #include "server/http_sky.h"
 #include "server/http_web.h"
@@ -474,13 +475,10 @@ void HttpApi::workers(const Request&, Response& res) { send_json(res, 200, {{"wo
 
 void HttpApi::sky(const Request& req, Response& res) { sky_->lookup(req, res); }
 
-// POST /v1/sky/radiance: the probe of DESIGN §5.2 answered here, in the
-// server process on one thread (not yet through the farm): "lut" from
-// one-bin tables per wavelength, "path" by the path tracer with standard
-// errors, both bounded so that one request cannot hold a connection thread
-// for long (larger probes: `skyfarm-worker probe`).
+// POST /v1/sky/radiance: the probe of DESIGN §5.2.  "lut" is answered here
+// from one-bin tables per wavelength (bounded: one table build each); "path"
+// is traced on the farm and waited for (server/http_probe.h).
 void HttpApi::sky_radiance(const Request& req, Response& res, const ContentReader& reader) {
-  constexpr double kMaxPaths = 4.0e6;    // about 5 s on one core
   constexpr std::size_t kMaxLutWavelengths = 64;  // one table build each
   const std::string body = read_body(req, res, reader);
   check_media_type(req);
@@ -488,15 +486,13 @@ void HttpApi::sky_radiance(const Request& req, Response& res, const ContentReade
     throw api::ValidationError(
         {api::FieldError{"", "JSON nested deeper than " + std::to_string(options_.max_json_depth) + " levels", ""}});
   const api::ProbeRequest request = api::parse_probe_request(std::string_view(body));
-  if (request.method == api::Method::kLut && request.wavelengths_nm.size() > kMaxLutWavelengths)
+  if (request.method == api::Method::kPath) {
+    answer_farm_probe(options_.probes.get(), request, options_.probe_timeout, res);
+    return;
+  }
+  if (request.wavelengths_nm.size() > kMaxLutWavelengths)
     throw api::ValidationError({api::FieldError{"wavelengths_nm", "at most 64 wavelengths with method lut on the server",
                                                 std::to_string(request.wavelengths_nm.size())}});
-  const double paths = static_cast<double>(request.samples) * static_cast<double>(request.directions.size()) *
-                       static_cast<double>(request.wavelengths_nm.size());
-  if (request.method == api::Method::kPath && paths > kMaxPaths)
-    throw api::ValidationError({api::FieldError{
-        "samples", "samples x directions x wavelengths must be at most 4e6 on the server (use skyfarm-worker probe)",
-        std::to_string(request.samples)}});
   send_json(res, 200, api::answer_probe(request, 1));
 }
 void HttpApi::sky_envmap(const Request& req, Response& res) { sky_->envmap(req, res); }
@@ -516,6 +512,7 @@ void HttpApi::metrics(const Request&, Response& res) {
   res.status = 200;
   std::string text = prometheus_text(backend_.metrics(), responses_, open_streams());
   append_sky_cache_metrics(text, sky_->service().stats());
+  if (options_.probes) append_probe_metrics(text, options_.probes->stats());
   res.set_content(std::move(text), kPrometheusContentType);
 }
 

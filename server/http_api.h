@@ -16,6 +16,9 @@
 //   GET    /v1/sky?...                  radiance in one direction from a cached LUT sky (JSON);
 //   GET    /v1/sky/envmap.exr?...       a cached lat-long environment map; both with strong
 //                                       ETags, If-None-Match -> 304 (server/http_sky.h)
+//   POST   /v1/sky/radiance             the radiance probe (DESIGN §5.2): "lut" from tables in
+//                                       this process, "path" traced on the farm and waited for
+//                                       (server/http_probe.h: 502, 503, 504)
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)
 //   GET    /, /web/<file>               the web page (server/http_web.h); public even with a token
 //   GET    /healthz                     {"status": "ok"}; never needs the token
@@ -29,14 +32,16 @@
 // (Allow); 409 image before the first pass; 413 body over max_body_bytes; 415
 // body not application/json; 422 Idempotency-Key reused with another body; 429
 // farm at capacity (Retry-After); 500 anything else (generic detail, logged to
-// stderr); 503 too many event streams (Retry-After); 507 data directory not
-// writable.
+// stderr); 502 a probe unit failed on the workers; 503 too many event
+// streams, or no worker for a probe (Retry-After); 504 a probe not answered
+// in time; 507 data directory not writable.
 //
 // Options: `token` (bearer token on every route but /healthz and the web
 // page; compared in constant time), `max_body_bytes`, `max_json_depth`
 // (stricter than the parser's own 32 when lower), `max_concurrent_streams`, `sse_keepalive`,
 // `http_threads` (httplib's pool), `on_response` (access log hook), `sky`
-// (the sky look-ups' caches, shared; a default one when null).
+// (the sky look-ups' caches, shared; a default one when null), `probes` and
+// `probe_timeout` (path-traced probes on the farm).
 //
 // register_routes() also configures the server: payload limit, timeouts,
 // keep-alive, thread pool, error/exception handlers and the logger (see
@@ -54,6 +59,7 @@
 #include "server/http_events.h"
 #include "server/http_metrics.h"
 #include "server/job_service.h"
+#include "server/probe_service.h"
 #include "server/sky_service.h"
 
 namespace httplib {
@@ -80,6 +86,9 @@ struct HttpOptions {
   std::function<void(const httplib::Request&, const httplib::Response&)> on_response;
   // The sky look-ups' caches (/v1/sky, /v1/sky/envmap.exr); null: a default SkyService.
   std::shared_ptr<SkyService> sky;
+  // Path-traced probes (POST /v1/sky/radiance) on the farm; null: answered 503.
+  std::shared_ptr<ProbeService> probes;
+  std::chrono::milliseconds probe_timeout = std::chrono::seconds(120);  // 504 beyond (server/http_probe.h)
 };
 
 class HttpApi {

@@ -5,6 +5,7 @@
 #include <set>
 #include <string_view>
 
+#include "server/probe_service.h"
 #include "server/sky_service.h"
 
 namespace skyfarm::server {
@@ -156,6 +157,40 @@ void append_sky_cache_metrics(std::string& out, const SkyCacheStats& s) {
   }
   header(out, "skyfarm_sky_cache_build_seconds_total", "counter", "Seconds spent building sky tables.");
   sample(out, "skyfarm_sky_cache_build_seconds_total", "cache=\"table\"", format_value(s.table_build_seconds));
+  header(out, "skyfarm_sky_cache_sun_only_builds_total", "counter",
+         "Sky tables built for a new sun from cached atmosphere tables (LutSky::with_sun).");
+  sample(out, "skyfarm_sky_cache_sun_only_builds_total", "cache=\"table\"",
+         std::to_string(s.table_sun_only_builds));
+}
+
+void append_probe_metrics(std::string& out, const ProbeStats& s) {
+  header(out, "skyfarm_probes_total", "counter", "Path-traced probes through the farm, by outcome.");
+  const std::pair<const char*, std::uint64_t> outcomes[] = {
+      {"done", s.done},           {"failed", s.failed},         {"timeout", s.timed_out},
+      {"no_workers", s.no_workers}, {"refused", s.refused_capacity}};
+  for (const auto& [outcome, n] : outcomes)
+    sample(out, "skyfarm_probes_total", std::string("outcome=\"") + outcome + "\"", std::to_string(n));
+  struct One {
+    std::string_view name, type, help;
+    std::uint64_t value;
+  };
+  const One ones[] = {
+      {"skyfarm_probes_active", "gauge", "Probes waiting for their answer.", s.active},
+      {"skyfarm_probe_queue_units", "gauge", "Probe units waiting to be dispatched.", s.queue_units},
+      {"skyfarm_probe_units_in_flight", "gauge", "Probe units dispatched and not returned yet.", s.units_in_flight},
+      {"skyfarm_probe_workers", "gauge", "Connected workers that run probe units.", s.workers},
+      {"skyfarm_probe_units_dispatched_total", "counter", "Probe units sent to workers.", s.units_dispatched},
+      {"skyfarm_probe_units_done_total", "counter", "Probe units merged.", s.units_done},
+      {"skyfarm_probe_unit_failures_total", "counter", "Probe units reported failed (or unreadable).",
+       s.unit_failures},
+      {"skyfarm_probe_unit_requeues_total", "counter", "Probe units dispatched again (lost worker, timeout).",
+       s.requeues},
+      {"skyfarm_probe_paths_total", "counter", "Paths traced for merged probe units.", s.paths},
+  };
+  for (const auto& o : ones) {
+    header(out, o.name, o.type, o.help);
+    sample(out, o.name, "", std::to_string(o.value));
+  }
 }
 
 }  // namespace skyfarm::server

@@ -39,8 +39,18 @@ std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter
 //   skyfarm_sky_cache_hits_total, _misses_total, _waits_total (waited for a
 //   build in progress), _builds_total, _build_failures_total, _evictions_total
 //   (counters), skyfarm_sky_cache_bytes, _entries, _capacity_bytes (gauges),
-//   and skyfarm_sky_cache_build_seconds_total{cache="table"} (counter).
+//   skyfarm_sky_cache_build_seconds_total{cache="table"} and
+//   skyfarm_sky_cache_sun_only_builds_total{cache="table"} (tables made for a
+//   new sun from cached atmosphere tables; counters).
 struct SkyCacheStats;
 void append_sky_cache_metrics(std::string& out, const SkyCacheStats& stats);
+
+// The farm's probes (server/probe_service.h): skyfarm_probes_total{outcome=
+// "done"|"failed"|"timeout"|"no_workers"|"refused"}, skyfarm_probe_units_
+// dispatched_total, _units_done_total, _unit_failures_total,
+// _unit_requeues_total, _paths_total (counters), skyfarm_probes_active,
+// skyfarm_probe_queue_units, _units_in_flight, _workers (gauges).
+struct ProbeStats;
+void append_probe_metrics(std::string& out, const ProbeStats& stats);
 
 }  // namespace skyfarm::server

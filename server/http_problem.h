@@ -28,6 +28,9 @@ inline constexpr std::string_view kProblemCapacity = "urn:skyfarm:problem:capaci
 inline constexpr std::string_view kProblemTooManyStreams = "urn:skyfarm:problem:too-many-streams";
 inline constexpr std::string_view kProblemStorage = "urn:skyfarm:problem:storage-error";
 inline constexpr std::string_view kProblemImageNotReady = "urn:skyfarm:problem:image-not-ready";
+inline constexpr std::string_view kProblemNoProbeWorkers = "urn:skyfarm:problem:no-probe-workers";
+inline constexpr std::string_view kProblemProbeTimeout = "urn:skyfarm:problem:probe-timeout";
+inline constexpr std::string_view kProblemProbeFailed = "urn:skyfarm:problem:probe-failed";
 
 struct Problem {
   int status = 500;

@@ -25,6 +25,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_request.h"
+#include "api/wire.h"
 
 namespace skyfarm::server {
 
@@ -43,6 +44,7 @@ struct UnitAssignment {
   UnitKey key;
   std::uint64_t attempt = 0;       // unique per dispatch; results of other attempts are dropped
   std::string request_canonical;   // api::canonical_text of the job's request (workers cache the setup per job)
+  api::UnitKind kind = api::UnitKind::kRender;  // kProbe: a radiance probe's unit (server/probe_service.h)
 };
 
 // --- Errors the HTTP layer maps to status codes ------------------------------

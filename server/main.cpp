@@ -3,6 +3,7 @@
 #include <httplib.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <iostream>
@@ -13,6 +14,8 @@
 #include "server/http_api.h"
 #include "server/job_service.h"
 #include "server/local_workers.h"
+#include "server/probe_router.h"
+#include "server/probe_service.h"
 #include "server/server_options.h"
 
 namespace {
@@ -63,16 +66,27 @@ int main(int argc, char** argv) {
     limits.max_active_jobs = options.max_active_jobs;
     limits.max_queue_units = options.max_queue_units;
     JobService service(options.data_dir, limits);
+    // Path-traced probes share the workers with renders, ahead of them (probe_router.h).
+    ProbeLimits probe_limits;
+    probe_limits.unit_timeout_s = std::min(options.unit_timeout_s, kProbeUnitTimeoutCapS);
+    auto probes = std::make_shared<ProbeService>(probe_limits);
+    ProbeRouter router(*probes, service);
 
     BrokerOptions broker_options;
     broker_options.endpoint = options.broker;
     broker_options.token = options.token;
-    Broker broker(service, broker_options);
+    Broker broker(router, broker_options);
     broker.start();
 
     HttpOptions http_options;
     if (!options.token.empty()) http_options.token = options.token;
     http_options.max_body_bytes = static_cast<std::size_t>(options.max_body_bytes);
+    http_options.probes = probes;
+    http_options.probe_timeout = std::chrono::milliseconds(static_cast<long long>(options.probe_timeout_s * 1000.0));
+    SkyServiceOptions sky;
+    sky.table_cache_bytes = static_cast<std::size_t>(options.sky_cache_mb) << 20;
+    sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
+    http_options.sky = std::make_shared<SkyService>(sky);
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);
@@ -98,6 +112,7 @@ int main(int argc, char** argv) {
     while (!g_stop) std::this_thread::sleep_for(std::chrono::milliseconds(100));
 
     std::cout << "skyfarm-server: shutting down" << std::endl;
+    probes->close();  // HTTP threads waiting for probes answer now
     workers.stop();
     broker.stop();
     http.stop();

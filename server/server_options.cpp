@@ -10,9 +10,15 @@ const char* const kServerUsage =
     "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
+    "                      [--probe-timeout SECONDS (default 120)] [--sky-cache-mb N (default 256)]\n"
+    "                      [--envmap-cache-mb N (default 128)]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
-    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES).\n"
+    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT,\n"
+    "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB).\n"
+    "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
+    "--sky-cache-mb, --envmap-cache-mb: MiB of LUT sky tables and of encoded env maps kept in memory\n"
+    "for GET /v1/sky and /v1/sky/envmap.exr (least recently used evicted first; 0 keeps none).\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
 
 namespace {
@@ -30,7 +36,13 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"},
                            {"--max-active-jobs", "SKYFARM_MAX_ACTIVE_JOBS"},
                            {"--max-queue-units", "SKYFARM_MAX_QUEUE_UNITS"},
-                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"}};
+                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"},
+                           {"--probe-timeout", "SKYFARM_PROBE_TIMEOUT"},
+                           {"--sky-cache-mb", "SKYFARM_SKY_CACHE_MB"},
+                           {"--envmap-cache-mb", "SKYFARM_ENVMAP_CACHE_MB"}};
+
+constexpr long long kMaxCacheMb = 1 << 20;  // 1 TiB: a typo guard, not a memory check
+constexpr double kMaxProbeTimeoutS = 3600.0;
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
@@ -38,6 +50,24 @@ long long whole_number(const std::string& value, long long lo, long long hi) {
   const long long n = std::stoll(value, &used);
   if (used != value.size() || n < lo || n > hi) throw std::invalid_argument("range");
   return n;
+}
+
+// The flags whose error says the expected range.
+std::string set_sizes_and_timeouts(const std::string& flag, const std::string& value, ServerOptions* o) {
+  try {
+    if (flag == "--sky-cache-mb" || flag == "--envmap-cache-mb") {
+      (flag == "--sky-cache-mb" ? o->sky_cache_mb : o->envmap_cache_mb) = whole_number(value, 0, kMaxCacheMb);
+    } else if (flag == "--probe-timeout") {
+      std::size_t used = 0;
+      const double s = std::stod(value, &used);
+      if (used != value.size() || !(s > 0.0 && s <= kMaxProbeTimeoutS)) throw std::invalid_argument("range");
+      o->probe_timeout_s = s;
+    }
+  } catch (const std::exception&) {
+    if (flag == "--probe-timeout") return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
+    return flag + ": invalid value '" + value + "' (a whole number of MiB in [0, 1048576])";
+  }
+  return "";
 }
 
 std::string set(const std::string& flag, const std::string& value, ServerOptions* o) {
@@ -70,7 +100,7 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
   } catch (const std::exception&) {
     return flag + ": invalid value '" + value + "'";
   }
-  return "";
+  return set_sizes_and_timeouts(flag, value, o);
 }
 
 }  // namespace

@@ -9,6 +9,12 @@
 //   --max-active-jobs N         queued + running jobs before 429 (SKYFARM_MAX_ACTIVE_JOBS)
 //   --max-queue-units N         units waiting over all jobs before 429 (SKYFARM_MAX_QUEUE_UNITS)
 //   --max-body-bytes N          request body limit, 413 beyond (SKYFARM_MAX_BODY_BYTES)
+//   --probe-timeout S           a path-traced probe not answered after S seconds: 504, its units
+//                               cancelled; (0, 3600], default 120 (SKYFARM_PROBE_TIMEOUT)
+//   --sky-cache-mb N            MiB of LUT sky tables kept for /v1/sky and env maps; [0, 1048576],
+//                               default 256; 0 keeps none (SKYFARM_SKY_CACHE_MB)
+//   --envmap-cache-mb N         MiB of encoded env maps kept; [0, 1048576], default 128
+//                               (SKYFARM_ENVMAP_CACHE_MB)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -28,6 +34,9 @@ struct ServerOptions {
   int max_active_jobs = 64;
   int max_queue_units = 4000000;
   long long max_body_bytes = 1 << 20;
+  double probe_timeout_s = 120.0;
+  long long sky_cache_mb = 256;
+  long long envmap_cache_mb = 128;
   bool help = false;
 };
 

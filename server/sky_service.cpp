@@ -97,15 +97,11 @@ std::string text_hash(std::string_view text) {
   return out;
 }
 
-std::string SkyTableParams::key() const {
-  const LutResolution& r = resolution;
-  std::string k = "lut1|atmosphere=";
-  k += api::atmosphere_json(atmosphere).dump();
-  k += "|sun=" + exact_decimal(sun_zenith_deg) + "," + exact_decimal(api::canonical_azimuth(sun_azimuth_deg)) + "," +
-       exact_decimal(sun_distance_au) + "," + exact_decimal(sun_angular_radius_deg);
-  k += "|altitude=" + exact_decimal(altitude_m);
-  k += "|nm=" + exact_decimal(min_nm) + "," + exact_decimal(max_nm);
-  k += "|res=";
+namespace {
+
+// The LUT resolution as text (every field: any of them changes the tables).
+std::string resolution_text(const LutResolution& r) {
+  std::string k;
   for (int v : {r.spectral_bins, r.medium_altitude_samples, r.phase_samples, r.transmittance_mu, r.transmittance_r,
                 r.transmittance_steps, r.multiple_scattering_mu_s, r.multiple_scattering_altitude,
                 r.multiple_scattering_directions, r.multiple_scattering_steps, r.ground_irradiance_mu_s,
@@ -116,31 +112,71 @@ std::string SkyTableParams::key() const {
   return k;
 }
 
+}  // namespace
+
+std::string SkyTableParams::key() const {
+  std::string k = "lut1|atmosphere=";
+  k += api::atmosphere_json(atmosphere).dump();
+  k += "|sun=" + exact_decimal(sun_zenith_deg) + "," + exact_decimal(api::canonical_azimuth(sun_azimuth_deg)) + "," +
+       exact_decimal(sun_distance_au) + "," + exact_decimal(sun_angular_radius_deg);
+  k += "|altitude=" + exact_decimal(altitude_m);
+  k += "|nm=" + exact_decimal(min_nm) + "," + exact_decimal(max_nm);
+  k += "|res=" + resolution_text(resolution);
+  return k;
+}
+
+std::string SkyTableParams::atmosphere_key() const {
+  std::string k = "lut1|atmosphere=";
+  k += api::atmosphere_json(atmosphere).dump();
+  k += "|nm=" + exact_decimal(min_nm) + "," + exact_decimal(max_nm);
+  k += "|res=" + resolution_text(resolution);
+  return k;
+}
+
 Xyz SkyTable::xyz(std::span<const double> per_bin) const {
   if (!visible) return {0.0, 0.0, 0.0};
   return visible->xyz(per_bin);
 }
 
-std::shared_ptr<const SkyTable> build_sky_table(const SkyTableParams& p) {
-  const auto start = std::chrono::steady_clock::now();
-  const Atmosphere atmosphere = build_atmosphere(p.atmosphere);
-  // The sun as Sun::from_spec makes it: AM0 scaled to the Earth-Sun distance.
+namespace {
+
+// The sun as Sun::from_spec makes it: AM0 scaled to the Earth-Sun distance.
+Sun table_sun(const SkyTableParams& p) {
   const auto& am0 = am0_irradiance();
   std::vector<double> x(am0.x().begin(), am0.x().end()), y(am0.y().begin(), am0.y().end());
   const double d2 = p.sun_distance_au * p.sun_distance_au;
   for (double& v : y) v /= d2;
-  Sun sun(p.sun_zenith_deg, p.sun_azimuth_deg, p.sun_angular_radius_deg,
-          PiecewiseLinear(std::move(x), std::move(y), PiecewiseLinear::Outside::kZero, "AM0"));
-  LutSky sky = LutSky::build(atmosphere, sun, p.altitude_m, p.min_nm, p.max_nm, p.resolution);
+  return Sun(p.sun_zenith_deg, p.sun_azimuth_deg, p.sun_angular_radius_deg,
+             PiecewiseLinear(std::move(x), std::move(y), PiecewiseLinear::Outside::kZero, "AM0"));
+}
+
+std::shared_ptr<const SkyTable> finish_table(const SkyTableParams& p, LutSky sky, Sun sun,
+                                             std::chrono::steady_clock::time_point start) {
   std::optional<BinnedSpectrumIntegral> visible;
   const double lo = std::max(kCieMinNm, p.min_nm), hi = std::min(kCieMaxNm, p.max_nm);
   if (lo < hi) visible.emplace(sky.grid(), lo, hi);
   const std::size_t extra = sizeof(SkyTable) + p.key().size() +
                             (visible ? 4 * visible->x_weights().size() * sizeof(double) : 0);
   const std::size_t bytes = sky.memory_bytes() + extra;
-  auto table = std::make_shared<SkyTable>(SkyTable{p.key(), std::move(sky), std::move(sun), std::move(visible), bytes,
-                                                   std::chrono::steady_clock::now() - start});
-  return table;
+  return std::make_shared<SkyTable>(SkyTable{p.key(), std::move(sky), std::move(sun), std::move(visible), bytes,
+                                             std::chrono::steady_clock::now() - start});
+}
+
+}  // namespace
+
+std::shared_ptr<const SkyTable> build_sky_table(const SkyTableParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  const Atmosphere atmosphere = build_atmosphere(p.atmosphere);
+  Sun sun = table_sun(p);
+  LutSky sky = LutSky::build(atmosphere, sun, p.altitude_m, p.min_nm, p.max_nm, p.resolution);
+  return finish_table(p, std::move(sky), std::move(sun), start);
+}
+
+std::shared_ptr<const SkyTable> sky_table_for_sun(const SkyTable& donor, const SkyTableParams& p) {
+  const auto start = std::chrono::steady_clock::now();
+  Sun sun = table_sun(p);
+  LutSky sky = donor.sky.with_sun(sun, p.altitude_m);
+  return finish_table(p, std::move(sky), std::move(sun), start);
 }
 
 SunDiskSummary sun_disk_summary(const SkyTable& table, int samples) {
@@ -270,13 +306,71 @@ std::shared_ptr<const SkyTable> SkyService::table(SkyTableParams params) {
   return tables_.get(
       key,
       [&] {
-        auto t = options_.table_builder ? options_.table_builder(params) : build_sky_table(params);
-        if (!t) throw std::runtime_error("sky table builder returned nothing");
+        auto t = make_table(params);
         build_nanoseconds_.fetch_add(std::chrono::duration_cast<std::chrono::nanoseconds>(t->build_time).count(),
                                      std::memory_order_relaxed);
         return t;
       },
       [](const SkyTable& t) { return t.bytes; });
+}
+
+std::shared_ptr<const SkyTable> SkyService::full_build(const SkyTableParams& params) {
+  auto t = options_.table_builder ? options_.table_builder(params) : build_sky_table(params);
+  if (!t) throw std::runtime_error("sky table builder returned nothing");
+  return t;
+}
+
+std::shared_ptr<const SkyTable> SkyService::make_table(const SkyTableParams& params) {
+  if (!options_.reuse_atmosphere_tables) return full_build(params);
+  const std::string atmosphere = params.atmosphere_key();
+  std::shared_ptr<const SkyTable> donor;
+  std::shared_future<std::shared_ptr<const SkyTable>> pending;
+  std::promise<std::shared_ptr<const SkyTable>> building;
+  {
+    std::lock_guard lock(atmospheres_mu_);
+    if (const auto it = atmosphere_donors_.find(atmosphere); it != atmosphere_donors_.end()) donor = it->second.lock();
+    if (!donor) {
+      if (const auto it = atmosphere_builds_.find(atmosphere); it != atmosphere_builds_.end())
+        pending = it->second;
+      else
+        atmosphere_builds_.emplace(atmosphere, building.get_future().share());
+    }
+  }
+  if (pending.valid()) {  // another sun of this atmosphere is being built in full: wait, then add ours
+    try {
+      donor = pending.get();
+    } catch (...) {
+      donor = nullptr;  // that build failed: ours is a full build (not shared)
+    }
+    if (!donor) return full_build(params);
+  }
+  if (donor) {
+    auto t = sky_table_for_sun(*donor, params);
+    sun_only_builds_.fetch_add(1, std::memory_order_relaxed);
+    std::lock_guard lock(atmospheres_mu_);
+    atmosphere_donors_[atmosphere] = t;
+    return t;
+  }
+  // We build this atmosphere's tables; later misses take theirs from ours.
+  std::shared_ptr<const SkyTable> t;
+  try {
+    t = full_build(params);
+  } catch (...) {
+    {
+      std::lock_guard lock(atmospheres_mu_);
+      atmosphere_builds_.erase(atmosphere);
+    }
+    building.set_exception(std::current_exception());
+    throw;
+  }
+  {
+    std::lock_guard lock(atmospheres_mu_);
+    atmosphere_builds_.erase(atmosphere);
+    std::erase_if(atmosphere_donors_, [](const auto& entry) { return entry.second.expired(); });
+    atmosphere_donors_[atmosphere] = t;
+  }
+  building.set_value(t);
+  return t;
 }
 
 std::shared_ptr<const EnvmapFile> SkyService::envmap(const std::string& key, const std::function<std::string()>& make) {
@@ -324,6 +418,7 @@ SkyCacheStats SkyService::stats() const {
   s.table_entries = t.entries;
   s.table_capacity_bytes = t.capacity;
   s.table_build_seconds = 1e-9 * static_cast<double>(build_nanoseconds_.load(std::memory_order_relaxed));
+  s.table_sun_only_builds = sun_only_builds_.load(std::memory_order_relaxed);
   s.envmap_hits = e.hits;
   s.envmap_misses = e.misses;
   s.envmap_waits = e.waits;

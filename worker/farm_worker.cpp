@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <deque>
 #include <iostream>
-#include <list>
 #include <map>
 #include <mutex>
 #include <random>
@@ -24,6 +23,8 @@
 #include "common/film/film_tile.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
+#include "worker/probe_unit.h"
+#include "worker/setup_cache.h"
 
 namespace skyfarm {
 namespace {
@@ -33,70 +34,33 @@ using Ms = std::chrono::milliseconds;
 
 constexpr Ms kMaxTick{100};  // longest poll: latency of drain_flag and of pause changes
 
-// --- Setup cache ----------------------------------------------------------------
+// --- Setups ---------------------------------------------------------------------
 
-// What renders the units of one job.
+// What renders the units of one render job.
 struct JobRenderer {
   api::RenderSetup setup;
   std::unique_ptr<TileRenderer> renderer;
 };
 
-// LRU of job id -> JobRenderer, shared by the render threads.  Each entry is
-// built once (under its own mutex, so threads rendering other jobs do not
-// wait); a request that cannot be set up caches its error.
-class SetupCache {
- public:
-  explicit SetupCache(std::size_t capacity) : capacity_(std::max<std::size_t>(1, capacity)) {}
-
-  // Throws std::runtime_error with the reason when the request cannot be rendered.
-  std::shared_ptr<const JobRenderer> get(const std::string& job, const std::string& request) {
-    const std::shared_ptr<Entry> e = entry(job, request);
-    std::lock_guard lock(e->mutex);
-    if (!e->built) build(*e);
-    if (!e->error.empty()) throw std::runtime_error(e->error);
-    return {e, &e->job};
-  }
-
- private:
-  struct Entry {
-    std::string request;
-    std::mutex mutex;
-    bool built = false;
-    std::string error;
+JobRenderer make_job_renderer(const std::string& request_text) {
+  try {
+    const api::RenderRequest request = api::parse_render_request(request_text);
     JobRenderer job;
-  };
-
-  std::shared_ptr<Entry> entry(const std::string& job, const std::string& request) {
-    std::lock_guard lock(mutex_);
-    const auto it = std::find_if(lru_.begin(), lru_.end(), [&](const auto& p) { return p.first == job; });
-    if (it != lru_.end() && it->second->request == request) {
-      lru_.splice(lru_.begin(), lru_, it);
-      return lru_.front().second;
-    }
-    if (it != lru_.end()) lru_.erase(it);
-    auto e = std::make_shared<Entry>();
-    e->request = request;
-    lru_.emplace_front(job, e);
-    while (lru_.size() > capacity_) lru_.pop_back();  // in-use entries live on in their users
-    return e;
+    job.setup = api::make_render_setup(request);
+    job.renderer = std::make_unique<TileRenderer>(*job.setup.scene, *job.setup.camera, job.setup.plan);
+    return job;
+  } catch (const api::ValidationError& ex) {
+    throw std::runtime_error(std::string("invalid request: ") + ex.what());
+  } catch (const std::exception& ex) {
+    throw std::runtime_error(std::string("cannot set up the render: ") + ex.what());
   }
+}
 
-  static void build(Entry& e) {
-    e.built = true;
-    try {
-      const api::RenderRequest request = api::parse_render_request(e.request);
-      e.job.setup = api::make_render_setup(request);
-      e.job.renderer = std::make_unique<TileRenderer>(*e.job.setup.scene, *e.job.setup.camera, e.job.setup.plan);
-    } catch (const api::ValidationError& ex) {
-      e.error = std::string("invalid request: ") + ex.what();
-    } catch (const std::exception& ex) {
-      e.error = std::string("cannot set up the render: ") + ex.what();
-    }
-  }
-
-  std::mutex mutex_;
-  std::list<std::pair<std::string, std::shared_ptr<Entry>>> lru_;  // most recent first
-  std::size_t capacity_;
+// The setups of render jobs and of probes, each an LRU of setup_cache_jobs.
+struct Setups {
+  explicit Setups(std::size_t jobs) : renders(jobs, make_job_renderer), probes(jobs, make_probe_setup) {}
+  SetupCache<JobRenderer> renders;
+  SetupCache<ProbeSetup> probes;
 };
 
 // --- Render pool ------------------------------------------------------------------
@@ -112,10 +76,12 @@ struct RenderOutcome {
   api::Message message;  // ResultMsg or FailedMsg
 };
 
-api::Message render_unit_message(SetupCache& cache, const api::UnitMsg& task) {
+api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
   const auto t0 = Clock::now();
   try {
-    const auto job = cache.get(task.unit.job, task.request);
+    if (task.kind == api::UnitKind::kProbe)
+      return run_probe_unit(*setups.probes.get(task.unit.job, task.request), task);
+    const auto job = setups.renders.get(task.unit.job, task.request);
     const RenderPlan& plan = job->renderer->plan();
     const api::UnitRef& u = task.unit;
     if (u.tile >= plan.tile_count() || u.batch >= plan.batches || u.pass >= plan.passes)
@@ -137,7 +103,7 @@ api::Message render_unit_message(SetupCache& cache, const api::UnitMsg& task) {
 class RenderPool {
  public:
   RenderPool(int threads, std::size_t cache_jobs, const api::WakeupPipe& wakeup)
-      : cache_(cache_jobs), wakeup_(wakeup) {
+      : setups_(cache_jobs), wakeup_(wakeup) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
   }
   ~RenderPool() { stop(); }
@@ -192,7 +158,7 @@ class RenderPool {
         task = std::move(tasks_.front());
         tasks_.pop_front();
       }
-      RenderOutcome outcome{task.session, task.unit.unit.attempt, render_unit_message(cache_, task.unit)};
+      RenderOutcome outcome{task.session, task.unit.unit.attempt, render_unit_message(setups_, task.unit)};
       {
         std::lock_guard lock(mutex_);
         outcomes_.push_back(std::move(outcome));
@@ -201,7 +167,7 @@ class RenderPool {
     }
   }
 
-  SetupCache cache_;
+  Setups setups_;
   const api::WakeupPipe& wakeup_;
   std::mutex mutex_;
   std::condition_variable cv_;
@@ -395,7 +361,7 @@ void FarmWorker::Impl::send_ready(zmq::socket_t& socket) {
   ready.id = options.id;
   ready.cores = threads;
   ready.slots = slots;
-  ready.capabilities = {{"spectral", true}, {"methods", {"path"}}};
+  ready.capabilities = {{"spectral", true}, {"methods", {"path"}}, {"probe", api::kProbeUnitsVersion}};
   ready.heartbeat_ms = static_cast<int>(options.heartbeat_interval.count());
   if (!options.token.empty()) ready.token = options.token;
   ++counters.sessions;

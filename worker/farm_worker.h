@@ -1,7 +1,8 @@
 // The farm worker: `skyfarm-worker --connect tcp://HOST:PORT` (DESIGN §4).
 // It connects a DEALER to the server's broker, speaks api/wire.h, and renders
 // the units it is sent with TileRenderer::render_unit, exactly as
-// `skyfarm-worker render` does, so the farm's image is bit-identical.
+// `skyfarm-worker render` does, so the farm's image is bit-identical (probe
+// units as `skyfarm-worker probe` traces them, so the probe's answer is too).
 //
 // Threads
 //   I/O thread     the thread calling run(): the only one touching the
@@ -19,10 +20,14 @@
 //   between a result leaving and the next unit arriving.  A worker started
 //   with --threads 1 (the server's embedded local workers) holds 2 units:
 //   one rendering while the next arrives.
-// Setups: api::make_render_setup is cached per job id (LRU of
-//   setup_cache_jobs = 4 jobs; an entry is rebuilt if the job's request text
+// Setups: api::make_render_setup (a probe's scene and plan) is cached per
+//   job id (worker/setup_cache.h: LRU of setup_cache_jobs = 4 jobs each for
+//   renders and probes; an entry is rebuilt if the job's request text
 //   differs).  A request that does not parse, an out-of-range unit or any
 //   exception while rendering is answered with FAILED and the message.
+// Probe units (UNIT kind "probe", worker/probe_unit.h) run on the same
+//   render threads and slots as render units; READY advertises them with
+//   the capability "probe": api::kProbeUnitsVersion.
 // CANCEL: a queued unit is dropped; one being rendered finishes but its
 //   result is not sent.
 // Server lost (nothing heard for heartbeat_liveness x interval, or a

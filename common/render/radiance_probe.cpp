@@ -1,57 +1,50 @@
 #include "common/render/radiance_probe.h"
 
-#include <cmath>
+#include <algorithm>
+#include <stdexcept>
 
 #include "common/render/parallel.h"
+#include "common/render/probe_units.h"
 
 namespace skyfarm {
 
 ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& directions,
                            const std::vector<double>& wavelengths_nm, int samples, std::uint64_t seed,
                            int threads) {
-  const VolumePathIntegrator integrator(scene);
-  const std::size_t pairs = directions.size() * wavelengths_nm.size();
-  const std::size_t blocks = static_cast<std::size_t>((samples + kProbeBlock - 1) / kProbeBlock);
-  struct BlockSums {
-    double sum = 0.0, sum_sq = 0.0;
-    PathCounters counters;
-  };
-  std::vector<BlockSums> sums(pairs * blocks);
-  parallel_for(pairs * blocks, threads, [&](std::size_t task, int) {
-    const std::size_t pair = task / blocks, block = task % blocks;
-    const glm::dvec3& d = directions[pair / wavelengths_nm.size()];
-    const double lambda = wavelengths_nm[pair % wavelengths_nm.size()];
-    // Monochromatic: every wavelength slot is the asked wavelength (pdf 1).
-    SampledWavelengths wl;
-    wl.lambda_nm.fill(lambda);
-    wl.pdf.fill(1.0);
-    BlockSums& out = sums[task];
-    const int s0 = static_cast<int>(block) * kProbeBlock;
-    const int s1 = std::min(samples, s0 + kProbeBlock);
-    for (int s = s0; s < s1; ++s) {
-      Sampler sampler(seed, pair, static_cast<std::uint64_t>(s));
-      const double L = integrator.radiance(Ray{scene.observer(), d}, wl, sampler, &out.counters)[0];
-      out.sum += L;
-      out.sum_sq += L * L;
-    }
+  const ProbePlan plan = ProbePlan::make(directions.size() * wavelengths_nm.size(),
+                                         static_cast<std::uint64_t>(std::max(samples, 0)));
+  return probe_radiance(scene, directions, wavelengths_nm, plan, seed, threads);
+}
+
+ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& directions,
+                           const std::vector<double>& wavelengths_nm, const ProbePlan& plan, std::uint64_t seed,
+                           int threads) {
+  if (plan.pairs != directions.size() * wavelengths_nm.size())
+    throw std::invalid_argument("probe_radiance: the plan is not for these directions and wavelengths");
+  // One task per pair of each unit: the cells a farm worker traces in a row,
+  // traced here in parallel (each cell's sum is the same either way).
+  std::vector<ProbeUnitSums> cells(plan.chunks * plan.pairs);
+  parallel_for(cells.size(), threads, [&](std::size_t task, int) {
+    const std::size_t chunk = task / plan.pairs, pair = task % plan.pairs;
+    ProbeUnit cell = plan.unit(chunk * plan.groups + pair / plan.pairs_per_unit);
+    cell.pair_begin = pair;
+    cell.pair_end = pair + 1;
+    cells[task] = trace_probe_unit(scene, directions, wavelengths_nm, seed, cell);
   });
-  ProbeResult r;
-  r.radiance.assign(directions.size(), std::vector<double>(wavelengths_nm.size(), 0.0));
-  r.standard_error = r.radiance;
-  for (std::size_t pair = 0; pair < pairs; ++pair) {
-    double sum = 0.0, sum_sq = 0.0;
-    for (std::size_t b = 0; b < blocks; ++b) {
-      sum += sums[pair * blocks + b].sum;
-      sum_sq += sums[pair * blocks + b].sum_sq;
-      r.counters.add(sums[pair * blocks + b].counters);
+  // Regroup the cells into the plan's units and reduce them as the server does.
+  ProbeReduction reduction(plan);
+  for (std::size_t i = 0; i < plan.unit_count(); ++i) {
+    ProbeUnitSums unit;
+    unit.unit = plan.unit(i);
+    for (std::size_t pair = unit.unit.pair_begin; pair < unit.unit.pair_end; ++pair) {
+      const ProbeUnitSums& cell = cells[unit.unit.chunk * plan.pairs + pair];
+      unit.sum.push_back(cell.sum[0]);
+      unit.sum_sq.push_back(cell.sum_sq[0]);
+      unit.counters.add(cell.counters);
     }
-    const double n = samples;
-    const double mean = sum / n;
-    const double var = n > 1 ? std::max(0.0, (sum_sq - n * mean * mean) / (n - 1.0)) : 0.0;
-    r.radiance[pair / wavelengths_nm.size()][pair % wavelengths_nm.size()] = mean;
-    r.standard_error[pair / wavelengths_nm.size()][pair % wavelengths_nm.size()] = std::sqrt(var / n);
+    reduction.add(unit);
   }
-  return r;
+  return reduction.result(wavelengths_nm.size());
 }
 
 }  // namespace skyfarm

@@ -100,7 +100,7 @@ TEST(ProbeRequestDefaults, MinimalProbeGetsEveryDefault) {
   EXPECT_TRUE(r.atmosphere.aerosol.has_value());
   EXPECT_EQ(r.location.altitude_m, 0.0);
   EXPECT_FALSE(r.time.has_value());
-  EXPECT_EQ(parse_probe_request(with(R"("method": "lut", "samples": 16777216)")).method, Method::kLut);
+  EXPECT_EQ(parse_probe_request(with(R"("method": "lut", "samples": 1000000000)")).method, Method::kLut);
 }
 
 TEST(ProbeRequestErrors, SharesTheRenderRequestFieldRules) {
@@ -123,7 +123,7 @@ TEST(ProbeRequestErrors, CollectsEveryInvalidDirectionAndWavelength) {
       "directions[1]: must be an object, got 5",
       "directions[2].azimuth_deg: must be a number in [0, 360], got 361",
       "wavelengths_nm[1]: must be a number in [230, 2500], got 229",
-      "samples: must be an integer in [1, 16777216], got 0",
+      "samples: must be an integer in [1, 1000000000], got 0",
   };
   EXPECT_EQ(m, expected);
 }

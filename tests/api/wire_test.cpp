@@ -40,6 +40,20 @@ TEST(WireTest, EveryMessageRoundTrips) {
   expect_round_trip(ReregisterMsg{});
 }
 
+// A probe unit says so ("kind": "probe"); a render unit's header is the
+// version 1 header (no "kind"), and an unknown kind is refused.
+TEST(WireTest, UnitKindTravelsAndRenderUnitsAreUnchanged) {
+  expect_round_trip(UnitMsg{sample_ref(), R"({"directions":[]})", UnitKind::kProbe});
+  const Frames render = encode(UnitMsg{sample_ref(), "{}"});
+  EXPECT_EQ(render[1].find("kind"), std::string::npos) << render[1];
+  const Frames probe = encode(UnitMsg{sample_ref(), "{}", UnitKind::kProbe});
+  EXPECT_NE(probe[1].find(R"("kind":"probe")"), std::string::npos) << probe[1];
+  const std::string header = R"({"job": "j", "tile": 0, "batch": 0, "pass": 0, "attempt": 1, "request": "{}", "kind": )";
+  EXPECT_EQ(std::get<UnitMsg>(decode({"UNIT", header + R"("render"})"})).kind, UnitKind::kRender);
+  EXPECT_THROW(decode({"UNIT", header + R"("film"})"}), WireError);
+  EXPECT_THROW(decode({"UNIT", header + "7}"}), WireError);
+}
+
 TEST(WireTest, ResultPayloadIsABinaryFrameNotJson) {
   const Frames f = encode(ResultMsg{sample_ref(), 1, 0.5, std::string("\0\1\2", 3)});
   ASSERT_EQ(f.size(), 3u);

@@ -24,6 +24,8 @@
 #include "tests/support/coarse_lut.h"
 #include "server/http_api.h"
 #include "tests/server/fake_backend.h"
+#include "tests/server/probe_workers.h"
+#include "api/probe_answer.h"
 
 namespace skyfarm::server {
 namespace {
@@ -40,13 +42,17 @@ nlohmann::json json_of(const httplib::Result& r) { return nlohmann::json::parse(
 
 class SkyHttpTest : public ::testing::Test {
  protected:
-  void start(std::optional<std::string> token = std::nullopt, SkyServiceOptions sky = {}) {
+  void start(std::optional<std::string> token = std::nullopt, SkyServiceOptions sky = {},
+             std::shared_ptr<ProbeService> probes = nullptr,
+             std::chrono::milliseconds probe_timeout = std::chrono::seconds(60)) {
     sky.resolution = coarse();
     sky.envmap_threads = 2;
     service_ = std::make_shared<SkyService>(sky);
     HttpOptions o;
     o.sky = service_;
     o.token = std::move(token);
+    o.probes = std::move(probes);
+    o.probe_timeout = probe_timeout;
     api_ = std::make_unique<HttpApi>(backend_, std::move(o));
     server_ = std::make_unique<httplib::Server>();
     api_->register_routes(*server_);
@@ -365,6 +371,13 @@ TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
     EXPECT_NE(m->body.find(expected), std::string::npos) << expected << " in\n" << m->body;
   EXPECT_NE(m->body.find("skyfarm_sky_cache_bytes{cache=\"table\"} " + std::to_string(service_->stats().table_bytes)),
             std::string::npos);
+  EXPECT_NE(m->body.find("skyfarm_sky_cache_sun_only_builds_total{cache=\"table\"} 0\n"), std::string::npos);
+  // Another sun of the same atmosphere: its tables come from the cached ones.
+  ASSERT_EQ(c.Get("/v1/sky?sun_zenith=60&sun_azimuth=90&view_zenith=0&view_azimuth=0")->status, 200);
+  m = c.Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("skyfarm_sky_cache_sun_only_builds_total{cache=\"table\"} 1\n"), std::string::npos)
+      << m->body;
 }
 
 TEST_F(SkyHttpTest, TokenMakesAnswersPrivateAndWrongMethodsAre405) {
@@ -421,11 +434,14 @@ TEST(SkyQuery, DefaultsAndCanonicalForm) {
 }
 
 // POST /v1/sky/radiance (DESIGN §5.2): the probe by the LUT (no standard
-// error) and by the path tracer (with standard errors), agreeing at the
-// zenith; bad bodies and probes too large for the server are 400s naming
-// the field.
+// error, in the server) and by the path tracer on the farm (with standard
+// errors; here two in-process workers), agreeing at the zenith; the farm's
+// answer is the local probe's document byte for byte; bad bodies and probes
+// too large for the server are 400s naming the field.
 TEST_F(SkyHttpTest, RadianceProbeByLutAndPathTracer) {
-  start();
+  auto probes = std::make_shared<ProbeService>();
+  skyfarm::testing::ProbeWorker a(*probes, "a"), b(*probes, "b");
+  start(std::nullopt, {}, probes);
   const std::string body = R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180},
     "directions": [{"zenith_deg": 0, "azimuth_deg": 0}], "wavelengths_nm": [550], "samples": 4096, "seed": 2,
     "method": ")";
@@ -434,16 +450,19 @@ TEST_F(SkyHttpTest, RadianceProbeByLutAndPathTracer) {
   ASSERT_TRUE(lut && path);
   ASSERT_EQ(lut->status, 200) << lut->body;
   ASSERT_EQ(path->status, 200) << path->body;
-  const auto a = json_of(lut), b = json_of(path);
-  EXPECT_EQ(a["method"], "lut");
-  EXPECT_TRUE(a["standard_error"].is_null());
-  EXPECT_EQ(b["method"], "path");
-  const double se = b["standard_error"][0][0];
+  const auto x_doc = json_of(lut), y_doc = json_of(path);
+  EXPECT_EQ(x_doc["method"], "lut");
+  EXPECT_TRUE(x_doc["standard_error"].is_null());
+  EXPECT_EQ(y_doc["method"], "path");
+  const double se = y_doc["standard_error"][0][0];
   EXPECT_GT(se, 0.0);
   // The production LUT (one 1 nm bin) is within 3 % + 4 standard errors of
   // the path tracer at the zenith (measured +0.4 % at 550 nm).
-  const double x = a["radiance"][0][0], y = b["radiance"][0][0];
+  const double x = x_doc["radiance"][0][0], y = y_doc["radiance"][0][0];
   EXPECT_NEAR(x, y, 0.03 * y + 4.0 * se);
+  EXPECT_EQ(path->body, api::answer_probe(api::parse_probe_request(body + R"(path"})"), 2).dump());
+  EXPECT_EQ(path->get_header_value("Server-Timing").rfind("probe;dur=", 0), 0u);
+  EXPECT_EQ(probes->stats().done, 1u);
 
   auto bad = client().Post("/v1/sky/radiance", R"({"directions": [], "wavelengths_nm": [550]})", "application/json");
   ASSERT_TRUE(bad);
@@ -451,15 +470,81 @@ TEST_F(SkyHttpTest, RadianceProbeByLutAndPathTracer) {
   EXPECT_NE(bad->body.find("directions"), std::string::npos) << bad->body;
   auto huge = client().Post("/v1/sky/radiance",
                             R"({"sun": {"zenith_deg": 30, "azimuth_deg": 0}, "directions": [{"zenith_deg": 0, "azimuth_deg": 0}],
-                                "wavelengths_nm": [450, 550, 650], "samples": 2000000})",
+                                "wavelengths_nm": [450, 550, 650], "samples": 400000000})",
                             "application/json");
   ASSERT_TRUE(huge);
   EXPECT_EQ(huge->status, 400);
   EXPECT_NE(huge->body.find("\"samples\""), std::string::npos) << huge->body;
+  // 10000 directions x 11 wavelengths: more pairs than the server answers.
+  nlohmann::json wide = {{"sun", {{"zenith_deg", 30}, {"azimuth_deg", 0}}}, {"samples", 1}};
+  for (int i = 0; i < 10000; ++i) wide["directions"].push_back({{"zenith_deg", i % 90}, {"azimuth_deg", 0}});
+  for (int w = 0; w < 11; ++w) wide["wavelengths_nm"].push_back(400 + 10 * w);
+  auto too_wide = client().Post("/v1/sky/radiance", wide.dump(), "application/json");
+  ASSERT_TRUE(too_wide);
+  EXPECT_EQ(too_wide->status, 400);
+  EXPECT_NE(too_wide->body.find("\"field\":\"directions\""), std::string::npos) << too_wide->body.substr(0, 400);
+  EXPECT_EQ(probes->stats().submitted, 1u) << "refused probes never reach the farm";
   auto get = client().Get("/v1/sky/radiance");
   ASSERT_TRUE(get);
   EXPECT_EQ(get->status, 405);
   EXPECT_EQ(get->get_header_value("Allow"), "POST");
+}
+
+constexpr const char* kPathProbe = R"({"sun": {"zenith_deg": 30, "azimuth_deg": 180},
+    "directions": [{"zenith_deg": 0, "azimuth_deg": 0}], "wavelengths_nm": [550], "samples": 1000})";
+
+void expect_problem(const httplib::Result& r, int status, const std::string& type) {
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, status) << r->body;
+  EXPECT_EQ(r->get_header_value("Content-Type"), "application/problem+json");
+  EXPECT_EQ(nlohmann::json::parse(r->body).value("type", ""), type) << r->body;
+}
+
+// No farm, or no worker that runs probes: 503 with Retry-After.
+TEST_F(SkyHttpTest, PathProbeWithoutWorkersIs503) {
+  auto probes = std::make_shared<ProbeService>();
+  probes->worker_joined("old", skyfarm::testing::worker_info("old", false));  // renders only
+  start(std::nullopt, {}, probes);
+  const auto r = client().Post("/v1/sky/radiance", kPathProbe, "application/json");
+  expect_problem(r, 503, "urn:skyfarm:problem:no-probe-workers");
+  EXPECT_EQ(r->get_header_value("Retry-After"), "5");
+  const auto m = client().Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("skyfarm_probes_total{outcome=\"no_workers\"} 1\n"), std::string::npos) << m->body;
+  EXPECT_NE(m->body.find("skyfarm_probe_workers 0\n"), std::string::npos);
+}
+
+TEST_F(SkyHttpTest, PathProbeWithoutAFarmIs503) {
+  start();
+  expect_problem(client().Post("/v1/sky/radiance", kPathProbe, "application/json"), 503,
+                 "urn:skyfarm:problem:no-probe-workers");
+}
+
+// Not answered within the server's limit: 504, the units cancelled.
+TEST_F(SkyHttpTest, LatePathProbeIs504) {
+  auto probes = std::make_shared<ProbeService>();
+  skyfarm::testing::ProbeWorker holder(*probes, "holder", skyfarm::testing::ProbeWorkerMode::kHold);
+  start(std::nullopt, {}, probes, std::chrono::milliseconds(200));
+  expect_problem(client().Post("/v1/sky/radiance", kPathProbe, "application/json"), 504,
+                 "urn:skyfarm:problem:probe-timeout");
+  holder.stop();
+  EXPECT_EQ(probes->take_cancelled_attempts().size(), 1u);
+  const auto m = client().Get("/metrics");
+  ASSERT_TRUE(m);
+  EXPECT_NE(m->body.find("skyfarm_probes_total{outcome=\"timeout\"} 1\n"), std::string::npos) << m->body;
+  EXPECT_NE(m->body.find("skyfarm_probes_active 0\n"), std::string::npos);
+}
+
+// A unit failing on 3 workers: 502 with the workers' message.
+TEST_F(SkyHttpTest, FailedPathProbeIs502WithTheWorkersMessage) {
+  auto probes = std::make_shared<ProbeService>();
+  using skyfarm::testing::ProbeWorker, skyfarm::testing::ProbeWorkerMode;
+  ProbeWorker a(*probes, "a", ProbeWorkerMode::kFail), b(*probes, "b", ProbeWorkerMode::kFail),
+      c(*probes, "c", ProbeWorkerMode::kFail);
+  start(std::nullopt, {}, probes);
+  const auto r = client().Post("/v1/sky/radiance", kPathProbe, "application/json");
+  expect_problem(r, 502, "urn:skyfarm:problem:probe-failed");
+  EXPECT_NE(r->body.find("boom from "), std::string::npos) << r->body;
 }
 
 }  // namespace

@@ -42,5 +42,45 @@ TEST(ServerOptions, BadValuesNameTheFlag) {
   ::unsetenv("SKYFARM_UNIT_TIMEOUT");
 }
 
+// The cache sizes and the probe timeout: defaults, flags, environment, and
+// bad values refused naming the flag and the range.
+TEST(ServerOptions, CacheSizesAndProbeTimeout) {
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({}, &o), "");
+  EXPECT_EQ(o.sky_cache_mb, 256);
+  EXPECT_EQ(o.envmap_cache_mb, 128);
+  EXPECT_EQ(o.probe_timeout_s, 120.0);
+  ::setenv("SKYFARM_ENVMAP_CACHE_MB", "64", 1);
+  ::setenv("SKYFARM_SKY_CACHE_MB", "999", 1);
+  ASSERT_EQ(parse_server_options({"--sky-cache-mb", "512", "--probe-timeout", "2.5"}, &o), "");
+  ::unsetenv("SKYFARM_ENVMAP_CACHE_MB");
+  ::unsetenv("SKYFARM_SKY_CACHE_MB");
+  EXPECT_EQ(o.sky_cache_mb, 512);
+  EXPECT_EQ(o.envmap_cache_mb, 64);
+  EXPECT_EQ(o.probe_timeout_s, 2.5);
+  ASSERT_EQ(parse_server_options({"--envmap-cache-mb", "0"}, &o), "");
+  EXPECT_EQ(o.envmap_cache_mb, 0) << "0 keeps nothing";
+
+  ServerOptions bad;
+  EXPECT_EQ(parse_server_options({"--sky-cache-mb", "-1"}, &bad),
+            "--sky-cache-mb: invalid value '-1' (a whole number of MiB in [0, 1048576])");
+  EXPECT_EQ(parse_server_options({"--sky-cache-mb", "1.5"}, &bad),
+            "--sky-cache-mb: invalid value '1.5' (a whole number of MiB in [0, 1048576])");
+  EXPECT_EQ(parse_server_options({"--envmap-cache-mb", "lots"}, &bad),
+            "--envmap-cache-mb: invalid value 'lots' (a whole number of MiB in [0, 1048576])");
+  EXPECT_EQ(parse_server_options({"--envmap-cache-mb", "1048577"}, &bad),
+            "--envmap-cache-mb: invalid value '1048577' (a whole number of MiB in [0, 1048576])");
+  EXPECT_EQ(parse_server_options({"--probe-timeout", "0"}, &bad),
+            "--probe-timeout: invalid value '0' (seconds in (0, 3600])");
+  EXPECT_EQ(parse_server_options({"--probe-timeout", "1e9"}, &bad),
+            "--probe-timeout: invalid value '1e9' (seconds in (0, 3600])");
+  EXPECT_EQ(parse_server_options({"--sky-cache-mb"}, &bad), "--sky-cache-mb: a value is required");
+  ::setenv("SKYFARM_SKY_CACHE_MB", "big", 1);
+  EXPECT_EQ(parse_server_options({}, &bad),
+            "--sky-cache-mb: invalid value 'big' (a whole number of MiB in [0, 1048576]) (from SKYFARM_SKY_CACHE_MB)");
+  ::unsetenv("SKYFARM_SKY_CACHE_MB");
+  EXPECT_EQ(bad.sky_cache_mb, 256) << "a refused value changes nothing";
+}
+
 }  // namespace
 }  // namespace skyfarm::server

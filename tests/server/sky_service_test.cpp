@@ -18,6 +18,7 @@
 
 #include "common/camera/camera.h"
 #include "common/image/exr_writer.h"
+#include "common/lut/fibonacci_directions.h"
 #include "tests/support/coarse_lut.h"
 
 namespace skyfarm::server {
@@ -186,6 +187,71 @@ TEST(SkyServiceCache, TablesAreEvictedByBytes) {
   s = service.stats();
   EXPECT_EQ(s.table_builds, 3u);
   EXPECT_EQ(s.table_evictions, 2u);
+}
+
+// A new sun (and altitude) of a cached atmosphere: only the sun-dependent
+// tables are built (LutSky::with_sun), and every look-up equals a full
+// build's bit for bit.
+TEST(SkyServiceCache, NewSunsReuseTheAtmosphereTablesBitForBit) {
+  SkyService service(coarse_options());
+  const auto noon = service.table(params(30.0, 180.0));
+  SkyTableParams evening = params(70.0, 250.0);
+  evening.altitude_m = 1500.0;
+  evening.sun_distance_au = 1.0167;
+  const auto reused = service.table(evening);
+  SkyCacheStats s = service.stats();
+  EXPECT_EQ(s.table_builds, 2u);
+  EXPECT_EQ(s.table_sun_only_builds, 1u);
+  const auto fresh = build_sky_table(evening);
+  EXPECT_EQ(reused->key, fresh->key);
+  EXPECT_EQ(reused->bytes, fresh->bytes) << "shared tables are counted in every entry";
+  const std::size_t B = static_cast<std::size_t>(fresh->sky.grid().size());
+  std::vector<double> a(B), b(B);
+  for (const glm::dvec3& d : lut::fibonacci_sphere(64)) {
+    for (bool disk : {false, true}) {
+      reused->sky.radiance(d, a, disk);
+      fresh->sky.radiance(d, b, disk);
+      for (std::size_t k = 0; k < B; ++k) ASSERT_EQ(a[k], b[k]) << "bin " << k;
+    }
+    EXPECT_EQ(reused->xyz(a).y, fresh->xyz(b).y);
+  }
+  // Another atmosphere is a full build; so is everything with reuse off.
+  SkyTableParams hazy = params(30.0, 180.0);
+  hazy.atmosphere.ozone_du = 350.0;
+  service.table(hazy);
+  EXPECT_EQ(service.stats().table_sun_only_builds, 1u);
+  SkyServiceOptions off = coarse_options();
+  off.reuse_atmosphere_tables = false;
+  SkyService before(off);
+  before.table(params(30.0, 180.0));
+  before.table(params(70.0, 250.0));
+  EXPECT_EQ(before.stats().table_sun_only_builds, 0u);
+}
+
+// Many suns of a new atmosphere at once: one full build, the rest wait for
+// it and add their sun.
+TEST(SkyServiceCache, ConcurrentSunsOfANewAtmosphereBuildItOnce) {
+  std::atomic<int> full_builds{0};
+  SkyServiceOptions o = coarse_options();
+  o.table_builder = [&](const SkyTableParams& p) {
+    ++full_builds;
+    std::this_thread::sleep_for(50ms);  // the others arrive while it builds
+    return build_sky_table(p);
+  };
+  SkyService service(o);
+  constexpr int kThreads = 6;
+  std::barrier start(kThreads);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kThreads; ++i)
+    threads.emplace_back([&, i] {
+      start.arrive_and_wait();
+      service.table(params(10.0 + 10.0 * i, 90.0));
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(full_builds.load(), 1);
+  const SkyCacheStats s = service.stats();
+  EXPECT_EQ(s.table_builds, static_cast<std::uint64_t>(kThreads));
+  EXPECT_EQ(s.table_sun_only_builds, static_cast<std::uint64_t>(kThreads - 1));
 }
 
 TEST(SkyServiceTable, ZenithAtMiddayIsBlueAndPositive) {

@@ -12,6 +12,7 @@
 
 #include <thread>
 
+#include "api/probe_answer.h"
 #include "api/render_setup.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
@@ -340,6 +341,52 @@ TEST_F(FarmWorkerTest, ProgramRejectsBadFlags) {
   EXPECT_EQ(wait_exit(spawn_worker({"--connect", "nowhere"}, {}), 5s), 2);
   EXPECT_EQ(wait_exit(spawn_worker({"--frobnicate", "1"}, {}), 5s), 2);
   EXPECT_EQ(wait_exit(spawn_worker({}, {"SKYFARM_SLOTS=-2"}), 5s), 2);
+}
+
+}  // namespace
+}  // namespace skyfarm
+
+namespace skyfarm {
+namespace {
+
+// Probe units (UNIT kind "probe"): the worker advertises them, traces them
+// on its render threads exactly as the local probe does (the RESULT's sums
+// are the bytes of trace_probe_unit), and answers a unit outside the plan,
+// or a probe that is not path traced, with FAILED.
+TEST_F(FarmWorkerTest, ProbeUnitsAreTracedAsTheLocalProbeDoes) {
+  start_broker();
+  const api::ProbeRequest probe = api::parse_probe_request(R"({"sun": {"zenith_deg": 40, "azimuth_deg": 0},
+      "directions": [{"zenith_deg": 30, "azimuth_deg": 0}], "wavelengths_nm": [500, 600], "samples": 300})");
+  const std::string text = api::canonical_text(probe);
+  api::ProbeRequest lut = probe;
+  lut.method = api::Method::kLut;
+  backend_.with_lock([&](auto& f) {
+    using server::UnitAssignment, server::UnitKey;
+    f.queue_.push_back(UnitAssignment{UnitKey{"probe-1", 0, 0, 0}, 0, text, api::UnitKind::kProbe});
+    f.queue_.push_back(UnitAssignment{UnitKey{"probe-1", 5, 0, 0}, 0, text, api::UnitKind::kProbe});
+    f.queue_.push_back(UnitAssignment{UnitKey{"probe-2", 0, 0, 0}, 0, api::canonical_text(lut), api::UnitKind::kProbe});
+    return 0;
+  });
+  start_worker();
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() + f.failed.size() == 3; }, 10s));
+  const ProbePlan plan = api::probe_plan(probe);
+  const std::vector<std::uint8_t> expected =
+      trace_probe_unit(api::probe_scene(probe), api::probe_directions(probe), probe.wavelengths_nm, probe.seed,
+                       plan.unit(0))
+          .serialize();
+  backend_.with_lock([&](auto& f) {
+    EXPECT_EQ(f.joined.at(0).second["capabilities"]["probe"], api::kProbeUnitsVersion);
+    ASSERT_EQ(f.done.size(), 1u);
+    EXPECT_EQ(f.done[0].bytes, expected);
+    EXPECT_EQ(f.done[0].paths, 600u);
+    ASSERT_EQ(f.failed.size(), 2u);
+    for (const auto& failed : f.failed) {
+      if (failed.key.job_id == "probe-1")
+        EXPECT_NE(failed.message.find("outside the probe's 1 units"), std::string::npos) << failed.message;
+      else
+        EXPECT_NE(failed.message.find("method is lut"), std::string::npos) << failed.message;
+    }
+  });
 }
 
 }  // namespace
