@@ -18,6 +18,8 @@
 //                                       ETags, If-None-Match -> 304 (server/http_sky.h)
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)
 //   GET    /healthz                     {"status": "ok"}; never needs the token
+//   /v1/timelapses...                   timelapses, when HttpOptions::timelapses is set
+//                                       (server/timelapse_http.h)
 //   GET    /metrics                     Prometheus text (text/plain; version=0.0.4)
 // Job ids are 1-64 of [A-Za-z0-9_-] (else 400, before the backend sees them).
 //
@@ -65,6 +67,8 @@ struct Response;
 namespace skyfarm::server {
 
 class SkyHttp;
+class TimelapseHttp;
+class TimelapseService;
 
 struct HttpOptions {
   std::optional<std::string> token;          // bearer token required on every route but /healthz when set
@@ -79,6 +83,8 @@ struct HttpOptions {
   std::function<void(const httplib::Request&, const httplib::Response&)> on_response;
   // The sky look-ups' caches (/v1/sky, /v1/sky/envmap.exr); null: a default SkyService.
   std::shared_ptr<SkyService> sky;
+  // The timelapses (not owned; must outlive the HttpApi); null: no /v1/timelapses routes.
+  TimelapseService* timelapses = nullptr;
 };
 
 class HttpApi {
@@ -141,6 +147,7 @@ class HttpApi {
   StreamSlots streams_;
   ResponseCounter responses_;
   std::unique_ptr<SkyHttp> sky_;
+  std::unique_ptr<TimelapseHttp> timelapses_;
 };
 
 }  // namespace skyfarm::server

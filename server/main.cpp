@@ -14,6 +14,7 @@
 #include "server/job_service.h"
 #include "server/local_workers.h"
 #include "server/server_options.h"
+#include "server/timelapse_service.h"
 
 namespace {
 
@@ -63,6 +64,10 @@ int main(int argc, char** argv) {
     limits.max_active_jobs = options.max_active_jobs;
     limits.max_queue_units = options.max_queue_units;
     JobService service(options.data_dir, limits);
+    TimelapseOptions timelapse_options;
+    timelapse_options.ffmpeg = options.ffmpeg;
+    timelapse_options.max_frames = options.max_timelapse_frames;
+    TimelapseService timelapses(service, options.data_dir, timelapse_options);
 
     BrokerOptions broker_options;
     broker_options.endpoint = options.broker;
@@ -73,6 +78,7 @@ int main(int argc, char** argv) {
     HttpOptions http_options;
     if (!options.token.empty()) http_options.token = options.token;
     http_options.max_body_bytes = static_cast<std::size_t>(options.max_body_bytes);
+    http_options.timelapses = &timelapses;
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);

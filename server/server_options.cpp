@@ -10,9 +10,11 @@ const char* const kServerUsage =
     "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
+    "                      [--ffmpeg PATH] [--max-timelapse-frames N]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
-    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES).\n"
+    "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_FFMPEG,\n"
+    "SKYFARM_MAX_TIMELAPSE_FRAMES).\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
 
 namespace {
@@ -30,7 +32,9 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"},
                            {"--max-active-jobs", "SKYFARM_MAX_ACTIVE_JOBS"},
                            {"--max-queue-units", "SKYFARM_MAX_QUEUE_UNITS"},
-                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"}};
+                           {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"},
+                           {"--ffmpeg", "SKYFARM_FFMPEG"},
+                           {"--max-timelapse-frames", "SKYFARM_MAX_TIMELAPSE_FRAMES"}};
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
@@ -55,6 +59,10 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
       o->max_queue_units = static_cast<int>(whole_number(value, 1, 1000000000));
     } else if (flag == "--max-body-bytes") {
       o->max_body_bytes = whole_number(value, 1024, 1LL << 30);
+    } else if (flag == "--max-timelapse-frames") {
+      o->max_timelapse_frames = static_cast<int>(whole_number(value, 2, 100000));
+    } else if (flag == "--ffmpeg") {
+      o->ffmpeg = value;
     } else if (flag == "--data-dir") {
       o->data_dir = value;
     } else if (flag == "--token") {

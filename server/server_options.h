@@ -9,6 +9,8 @@
 //   --max-active-jobs N         queued + running jobs before 429 (SKYFARM_MAX_ACTIVE_JOBS)
 //   --max-queue-units N         units waiting over all jobs before 429 (SKYFARM_MAX_QUEUE_UNITS)
 //   --max-body-bytes N          request body limit, 413 beyond (SKYFARM_MAX_BODY_BYTES)
+//   --ffmpeg PATH               ffmpeg for timelapse videos; default: ffmpeg on PATH (SKYFARM_FFMPEG)
+//   --max-timelapse-frames N    frames per timelapse, 400 beyond; default 1000 (SKYFARM_MAX_TIMELAPSE_FRAMES)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -28,6 +30,8 @@ struct ServerOptions {
   int max_active_jobs = 64;
   int max_queue_units = 4000000;
   long long max_body_bytes = 1 << 20;
+  std::string ffmpeg;              // "": ffmpeg on PATH
+  int max_timelapse_frames = 1000;
   bool help = false;
 };
 
