@@ -266,6 +266,12 @@ TEST(TimelapseFarm, BadRequestsNameTheFieldAndFilesWaitForTheirTurn) {
   ASSERT_TRUE(put);
   EXPECT_EQ(put->status, 405);
   EXPECT_EQ(put->get_header_value("Allow"), "GET, HEAD, DELETE");
+  // The OpenAPI document the server serves names every timelapse route.
+  const Answer openapi = get(server, "/v1/openapi.yaml");
+  for (const char* route : {"/v1/timelapses:", "/v1/timelapses/{id}:", "/v1/timelapses/{id}/frames:",
+                            "/v1/timelapses/{id}/frames/{n}.exr:", "/v1/timelapses/{id}/frames/{n}.png:",
+                            "/v1/timelapses/{id}/contact_sheet.png:", "/v1/timelapses/{id}/video.mp4:"})
+    EXPECT_NE(openapi.body.find(route), std::string::npos) << route;
   EXPECT_EQ(get(server, "/healthz").status, 200);
 }
 
