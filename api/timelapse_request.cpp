@@ -158,10 +158,15 @@ void refuse_fixed_time(const Fields& top) {
 
 TimelapseRequest read_timelapse_request(const Json& body, int max_frames, Errors& e) {
   if (!body.is_object()) throw ValidationError({FieldError{"", "must be a JSON object", value_text(body)}});
+  {
+    // "time" gets its own error (refuse_fixed_time), not "unknown field".
+    Json others = body;
+    others.erase("time");
+    Fields(others, "", e).allow_only({"location", "sun", "camera", "atmosphere", "spectral", "quality", "method",
+                                      "output", "seed", "priority", "start", "end", "step_s", "frames", "same_seed",
+                                      "exposure_smoothing_frames", "video_fps"});
+  }
   Fields top(body, "", e);
-  top.allow_only({"location", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output", "seed",
-                  "priority", "time", "start", "end", "step_s", "frames", "same_seed", "exposure_smoothing_frames",
-                  "video_fps"});
   TimelapseRequest r;
   refuse_fixed_time(top);
   bool range_valid = false;

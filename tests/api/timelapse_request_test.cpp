@@ -145,6 +145,12 @@ TEST(TimelapseRequest, ErrorsNameTheField) {
   }
   EXPECT_EQ(first_message(body(range + R"(, "step_s": 1)")),
             "step_s: gives 3601 frames; at most 1000 (a larger step_s, or frames), got 1");
+  // "time" is refused once, with the reason, and is not listed among the allowed fields.
+  const std::string with_time = body(range + R"(, "frames": 3, "time": "2013-05-27T19:00:00Z")");
+  EXPECT_EQ(error_fields(with_time), std::vector<std::string>{"time"});
+  const std::string unknown = first_message(body(range + R"(, "frames": 3, "fps": 3)"));
+  EXPECT_TRUE(unknown.starts_with("fps: unknown field (allowed: location, sun, camera,")) << unknown;
+  EXPECT_EQ(unknown.find("time"), std::string::npos) << unknown;
   // Every error at once, as for renders.
   EXPECT_EQ(error_fields(body(R"("frames": 1, "video_fps": 500)")).size(), 4u);
 }
