@@ -776,10 +776,15 @@ void read_location(const Fields& top, Location& out) {
 
 // "time": ISO 8601 with a UTC offset, years 1800-2200; null = absent.
 void read_time(const Fields& top, std::optional<UtcInstant>& time, std::optional<std::string>& time_text) {
-  const Json* v = top.find_value("time");
+  read_instant(top, "time", time, time_text);
+}
+
+void read_instant(const Fields& f, std::string_view name, std::optional<UtcInstant>& time,
+                  std::optional<std::string>& time_text) {
+  const Json* v = f.find_value(name);
   if (!v) return;
-  Errors& e = top.errors();
-  const std::string path = top.path_of("time");
+  Errors& e = f.errors();
+  const std::string path = f.path_of(name);
   if (!v->is_string()) {
     e.add(path, "must be a string (ISO 8601 with a UTC offset)", value_text(*v));
     return;

@@ -220,6 +220,10 @@ inline constexpr Choice<Method> kMethods[] = {{"path", Method::kPath}, {"lut", M
 void read_location(const Fields& top, Location& out);
 void read_time(const Fields& top, std::optional<UtcInstant>& time,
                std::optional<std::string>& time_text);
+// Any field holding an instant like "time" (ISO 8601 with a UTC offset, years
+// kMinYear..kMaxYear): absent or null leaves both outputs unchanged.
+void read_instant(const Fields& f, std::string_view name, std::optional<UtcInstant>& time,
+                  std::optional<std::string>& time_text);
 void read_sun(const Fields& top, SunSpec& out);
 // DESIGN §5.1: "now" is never a default; without "time" both sun angles are needed.
 void require_time_or_sun(const Fields& top);

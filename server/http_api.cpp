@@ -17,6 +17,7 @@
 #include "server/http_problem.h"
 #include "server/http_sky.h"
 #include "server/http_web.h"
+#include "server/timelapse_http.h"
 #include "api/probe_answer.h"
 
 namespace skyfarm::server {
@@ -74,6 +75,7 @@ nlohmann::json render_links(const std::string& id) {
 
 // "GET, HEAD, POST" for a path the API serves with other methods, else nullopt.
 std::optional<std::string_view> allowed_methods(std::string_view path) {
+  if (auto timelapse = timelapse_allowed_methods(path)) return timelapse;
   if (path == "/v1/renders") return "GET, HEAD, POST";
   if (path == "/v1/sky/radiance") return "POST";
   if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
@@ -224,7 +226,10 @@ HttpApi::HttpApi(HttpBackend& backend, HttpOptions options)
       options_(std::move(options)),
       streams_(std::max(0, options_.max_concurrent_streams)),
       sky_(std::make_unique<SkyHttp>(options_.sky ? options_.sky : std::make_shared<SkyService>(),
-                                     options_.token.has_value())) {}
+                                     options_.token.has_value())) {
+  if (options_.timelapses)
+    timelapses_ = std::make_unique<TimelapseHttp>(*options_.timelapses, options_.token.has_value());
+}
 
 HttpApi::~HttpApi() = default;
 
@@ -344,6 +349,20 @@ void HttpApi::add_routes(httplib::Server& server) {
   server.Get("/metrics", guarded(&HttpApi::metrics));
   server.Get("/", guarded(&HttpApi::web_file));
   server.Get(kWebAssetRoute, guarded(&HttpApi::web_file));
+  if (timelapses_)
+    timelapses_->add_routes(
+        server, {[](const Request& req, Response& res, const std::function<void()>& handler) {
+                   run_guarded(req, res, handler);
+                 },
+                 [this](const Request& req, Response& res, const ContentReader& reader) {
+                   std::string body = read_body(req, res, reader);
+                   check_media_type(req);
+                   if (options_.max_json_depth < api::kMaxJsonDepth && json_deeper_than(body, options_.max_json_depth))
+                     throw api::ValidationError({api::FieldError{
+                         "", "JSON nested deeper than " + std::to_string(options_.max_json_depth) + " levels", ""}});
+                   return body;
+                 },
+                 [](const Request& req) { return idempotency_key_of(req); }});
 }
 
 void HttpApi::add_fallbacks(httplib::Server& server) {

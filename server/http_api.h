@@ -22,6 +22,8 @@
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)
 //   GET    /, /web/<file>               the web page (server/http_web.h); public even with a token
 //   GET    /healthz                     {"status": "ok"}; never needs the token
+//   /v1/timelapses...                   timelapses, when HttpOptions::timelapses is set
+//                                       (server/timelapse_http.h)
 //   GET    /metrics                     Prometheus text (text/plain; version=0.0.4)
 // Job ids are 1-64 of [A-Za-z0-9_-] (else 400, before the backend sees them).
 //
@@ -72,6 +74,8 @@ struct Response;
 namespace skyfarm::server {
 
 class SkyHttp;
+class TimelapseHttp;
+class TimelapseService;
 
 struct HttpOptions {
   std::optional<std::string> token;          // bearer token required on every route but /healthz when set
@@ -89,6 +93,8 @@ struct HttpOptions {
   // Path-traced probes (POST /v1/sky/radiance) on the farm; null: answered 503.
   std::shared_ptr<ProbeService> probes;
   std::chrono::milliseconds probe_timeout = std::chrono::seconds(120);  // 504 beyond (server/http_probe.h)
+  // The timelapses (not owned; must outlive the HttpApi); null: no /v1/timelapses routes.
+  TimelapseService* timelapses = nullptr;
 };
 
 class HttpApi {
@@ -152,6 +158,7 @@ class HttpApi {
   StreamSlots streams_;
   ResponseCounter responses_;
   std::unique_ptr<SkyHttp> sky_;
+  std::unique_ptr<TimelapseHttp> timelapses_;
 };
 
 }  // namespace skyfarm::server

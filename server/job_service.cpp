@@ -111,6 +111,7 @@ struct Job {
   int preview_units = -1;
   fs::path dir;
   std::vector<std::uint32_t> sun_pixels;  // left out of the error estimate
+  std::string group;                      // shares out passes with its group (set_group)
 
   std::size_t unit_index(const WorkUnit& u) const {
     return (static_cast<std::size_t>(u.pass) * static_cast<std::size_t>(plan.tile_count()) +
@@ -159,6 +160,7 @@ struct JobService::Impl {
   std::int64_t next_sequence = 1;
   std::uint64_t unit_failures = 0, requeues = 0;
   std::deque<std::pair<Clock::time_point, std::uint64_t>> recent_paths;  // for samples/s
+  std::function<void(const std::string&, const std::string&)> state_observer;
 
   Job& add_job(JobRecord record, api::RenderRequest request);
   void set_state(Job& job, const std::string& state, const std::string& failure = "");
@@ -169,6 +171,7 @@ struct JobService::Impl {
   void requeue(std::uint64_t attempt, bool tell_worker);
   void fail_job(Job& job, const std::string& message);
   void drop_attempts_of(Job& job);
+  Job& lowest_pass_in_group(Job& chosen);
 };
 
 // --- Construction and restart -------------------------------------------------
@@ -226,6 +229,7 @@ void JobService::Impl::set_state(Job& job, const std::string& state, const std::
   job.record.state = state;
   job.record.failure = failure;
   if (is_terminal(state)) job.end_time = Clock::now();
+  if (state_observer) state_observer(job.record.id, state);
 }
 
 void JobService::Impl::emit(Job& job, const std::string& type) {
@@ -549,7 +553,7 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
     if (!best || job.record.priority > best->record.priority) best = &job;
   }
   if (!best) return std::nullopt;
-  Job& job = *best;
+  Job& job = best->group.empty() ? *best : impl_->lowest_pass_in_group(*best);
   std::optional<WorkUnit> unit;
   while (!job.requeued.empty() && !unit) {
     const WorkUnit u = job.requeued.front();
@@ -574,6 +578,29 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
   ++job.in_flight;
   if (auto w = workers.find(worker_id); w != workers.end()) ++w->second.in_flight;
   return UnitAssignment{{job.record.id, unit->tile, unit->batch, unit->pass}, attempt, job.record.request};
+}
+
+// The pass of the unit a job would hand out next (requeued units first).
+static int next_pass(const Job& job) {
+  if (!job.requeued.empty()) return job.requeued.front().pass;
+  return unit_at(job.plan, job.cursor).pass;
+}
+
+// Among `chosen`'s group at its priority, the job whose next unit has the
+// lowest pass; the earliest submitted on a tie (set_group).
+Job& JobService::Impl::lowest_pass_in_group(Job& chosen) {
+  Job* pick = &chosen;
+  int pick_pass = next_pass(chosen);
+  for (const auto& id : order) {
+    Job& job = *jobs.at(id);
+    if (job.group != chosen.group || job.record.priority != chosen.record.priority || !job.has_work()) continue;
+    const int pass = next_pass(job);
+    if (pass < pick_pass) {
+      pick = &job;
+      pick_pass = pass;
+    }
+  }
+  return *pick;
 }
 
 void JobService::Impl::fail_job(Job& job, const std::string& message) {
@@ -715,6 +742,38 @@ void JobService::check_timeouts(Clock::time_point now) {
   for (const auto& [a, f] : impl_->in_flight)
     if (now - f.since > limit) late.push_back(a);
   for (auto a : late) impl_->requeue(a, true);
+}
+
+// --- Timelapse support ------------------------------------------------------
+
+bool JobService::set_group(const std::string& id, const std::string& group) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return false;
+  it->second->group = group;
+  return true;
+}
+
+std::optional<JobSummary> JobService::summary(const std::string& id) const {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return std::nullopt;
+  const Job& job = *it->second;
+  JobSummary s;
+  s.state = job.record.state;
+  const int total = job.merger->total_units();
+  s.fraction = job.record.state == "done" ? 1.0
+               : total > 0               ? static_cast<double>(job.merger->merged_units()) / total
+                                         : 1.0;
+  if (!job.history.empty() && job.history.back()["estimated_relative_rms"].is_number())
+    s.estimated_relative_rms = job.history.back()["estimated_relative_rms"].get<double>();
+  s.failure = job.record.failure;
+  return s;
+}
+
+void JobService::set_state_observer(std::function<void(const std::string&, const std::string&)> observer) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  impl_->state_observer = std::move(observer);
 }
 
 }  // namespace skyfarm::server

@@ -16,6 +16,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <optional>
@@ -83,6 +84,15 @@ struct JobEvent {
   std::uint64_t sequence = 0;  // per job, increasing from 1
   std::string type;            // "progress", "done", "failed", "cancelled"
   nlohmann::json data;         // the status document at that moment
+};
+
+// A job's state in brief, cheaper than its status document (a timelapse
+// follows many frames).
+struct JobSummary {
+  std::string state;
+  double fraction = 0.0;                          // units merged / units total (1 when done)
+  std::optional<double> estimated_relative_rms;   // after the first complete pass
+  std::string failure;                            // when failed
 };
 
 struct ServiceLimits {
@@ -165,6 +175,20 @@ class JobService final : public HttpBackend, public BrokerBackend {
                    const std::string& message) override;
   std::vector<std::pair<std::string, std::uint64_t>> take_cancelled_attempts() override;
   void check_timeouts(Clock::time_point now) override;
+
+  // --- For timelapses (server/timelapse_service.h) ---------------------------
+  // Jobs of one group (a timelapse's frames) share out their passes: when the
+  // job chosen by priority and submission order has a group, the unit handed
+  // out is the one of the lowest next pass among that group's jobs of the
+  // same priority (ties: submission order), so every frame gets pass p before
+  // any gets pass p + 1 and the frames fill in together.  Groups are not
+  // persisted: their owner sets them again after a restart.  false: unknown id.
+  bool set_group(const std::string& id, const std::string& group);
+  std::optional<JobSummary> summary(const std::string& id) const;
+  // Called with (job id, new state) on every state change, under the
+  // service's lock: it must not call into the service (wake a thread instead).
+  // An empty function removes the observer.
+  void set_state_observer(std::function<void(const std::string&, const std::string&)> observer);
 
  private:
   struct Impl;

@@ -17,6 +17,7 @@
 #include "server/probe_router.h"
 #include "server/probe_service.h"
 #include "server/server_options.h"
+#include "server/timelapse_service.h"
 
 namespace {
 
@@ -71,6 +72,10 @@ int main(int argc, char** argv) {
     probe_limits.unit_timeout_s = std::min(options.unit_timeout_s, kProbeUnitTimeoutCapS);
     auto probes = std::make_shared<ProbeService>(probe_limits);
     ProbeRouter router(*probes, service);
+    TimelapseOptions timelapse_options;
+    timelapse_options.ffmpeg = options.ffmpeg;
+    timelapse_options.max_frames = options.max_timelapse_frames;
+    TimelapseService timelapses(service, options.data_dir, timelapse_options);
 
     BrokerOptions broker_options;
     broker_options.endpoint = options.broker;
@@ -87,6 +92,7 @@ int main(int argc, char** argv) {
     sky.table_cache_bytes = static_cast<std::size_t>(options.sky_cache_mb) << 20;
     sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
     http_options.sky = std::make_shared<SkyService>(sky);
+    http_options.timelapses = &timelapses;
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);

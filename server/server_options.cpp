@@ -11,11 +11,11 @@ const char* const kServerUsage =
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
     "                      [--probe-timeout SECONDS (default 120)] [--sky-cache-mb N (default 256)]\n"
-    "                      [--envmap-cache-mb N (default 128)]\n"
+    "                      [--envmap-cache-mb N (default 128)] [--ffmpeg PATH] [--max-timelapse-frames N]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
     "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT,\n"
-    "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB).\n"
+    "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB, SKYFARM_FFMPEG, SKYFARM_MAX_TIMELAPSE_FRAMES).\n"
     "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
     "--sky-cache-mb, --envmap-cache-mb: MiB of LUT sky tables and of encoded env maps kept in memory\n"
     "for GET /v1/sky and /v1/sky/envmap.exr (least recently used evicted first; 0 keeps none).\n"
@@ -39,7 +39,9 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--max-body-bytes", "SKYFARM_MAX_BODY_BYTES"},
                            {"--probe-timeout", "SKYFARM_PROBE_TIMEOUT"},
                            {"--sky-cache-mb", "SKYFARM_SKY_CACHE_MB"},
-                           {"--envmap-cache-mb", "SKYFARM_ENVMAP_CACHE_MB"}};
+                           {"--envmap-cache-mb", "SKYFARM_ENVMAP_CACHE_MB"},
+                           {"--ffmpeg", "SKYFARM_FFMPEG"},
+                           {"--max-timelapse-frames", "SKYFARM_MAX_TIMELAPSE_FRAMES"}};
 
 constexpr long long kMaxCacheMb = 1 << 20;  // 1 TiB: a typo guard, not a memory check
 constexpr double kMaxProbeTimeoutS = 3600.0;
@@ -85,6 +87,10 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
       o->max_queue_units = static_cast<int>(whole_number(value, 1, 1000000000));
     } else if (flag == "--max-body-bytes") {
       o->max_body_bytes = whole_number(value, 1024, 1LL << 30);
+    } else if (flag == "--max-timelapse-frames") {
+      o->max_timelapse_frames = static_cast<int>(whole_number(value, 2, 100000));
+    } else if (flag == "--ffmpeg") {
+      o->ffmpeg = value;
     } else if (flag == "--data-dir") {
       o->data_dir = value;
     } else if (flag == "--token") {

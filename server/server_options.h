@@ -15,6 +15,8 @@
 //                               default 256; 0 keeps none (SKYFARM_SKY_CACHE_MB)
 //   --envmap-cache-mb N         MiB of encoded env maps kept; [0, 1048576], default 128
 //                               (SKYFARM_ENVMAP_CACHE_MB)
+//   --ffmpeg PATH               ffmpeg for timelapse videos; default: ffmpeg on PATH (SKYFARM_FFMPEG)
+//   --max-timelapse-frames N    frames per timelapse, 400 beyond; default 1000 (SKYFARM_MAX_TIMELAPSE_FRAMES)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -37,6 +39,8 @@ struct ServerOptions {
   double probe_timeout_s = 120.0;
   long long sky_cache_mb = 256;
   long long envmap_cache_mb = 128;
+  std::string ffmpeg;              // "": ffmpeg on PATH
+  int max_timelapse_frames = 1000;
   bool help = false;
 };
 

@@ -115,6 +115,40 @@ std::string shortest(double v) {
   return std::string(buf, r.ptr);
 }
 
+// Encodes RGB rows (8 or 16 bits, sRGB) with iTXt text chunks (UTF-8; long
+// values compressed) and writes the file atomically.
+void write_png_rows(const std::filesystem::path& path, int w, int h, int bit_depth, png_bytepp rows,
+                    std::vector<std::pair<std::string, std::string>>& entries) {
+  std::vector<png_text> texts(entries.size());
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    png_text& t = texts[i];
+    std::memset(&t, 0, sizeof t);
+    t.compression = entries[i].second.size() > 1024 ? PNG_ITXT_COMPRESSION_zTXt : PNG_ITXT_COMPRESSION_NONE;
+    t.key = entries[i].first.data();
+    t.text = entries[i].second.data();
+    t.itxt_length = entries[i].second.size();
+    t.lang = nullptr;
+    t.lang_key = nullptr;
+  }
+
+  std::vector<png_byte> encoded;
+  PngErrorState err{};
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_png_error, on_png_warning);
+  if (png == nullptr) throw FileWriteError("cannot write '" + path.string() + "': libpng initialisation failed");
+  png_infop info = png_create_info_struct(png);
+  if (info == nullptr) {
+    png_destroy_write_struct(&png, nullptr);
+    throw FileWriteError("cannot write '" + path.string() + "': libpng initialisation failed");
+  }
+  png_set_write_fn(png, &encoded, on_png_write, on_png_flush);
+  const bool ok = encode_png(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), bit_depth, rows,
+                             texts.data(), static_cast<int>(texts.size()));
+  png_destroy_write_struct(&png, &info);
+  if (!ok) throw FileWriteError("cannot write '" + path.string() + "': libpng: " + err.message);
+
+  AtomicFile::write_file(path, encoded.data(), encoded.size());
+}
+
 }  // namespace
 
 double exposure_scale(double ev100) { return kMiddleGrey * std::exp2(3.0 - ev100); }
@@ -169,7 +203,6 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   std::vector<png_bytep> rows(static_cast<std::size_t>(h));
   for (int y = 0; y < h; ++y) rows[static_cast<std::size_t>(y)] = pixels.data() + row_bytes * static_cast<std::size_t>(y);
 
-  // Text chunks (iTXt, UTF-8; long values compressed).
   std::vector<std::pair<std::string, std::string>> entries;
   for (const auto& [key, value] : image.metadata()) {
     const auto* s = std::get_if<std::string>(&value);
@@ -177,35 +210,21 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   }
   entries.emplace_back("skyfarm:exposure_ev100", shortest(report.exposure_ev));
   entries.emplace_back("skyfarm:exposure_scale", shortest(report.scale));
-  std::vector<png_text> texts(entries.size());
-  for (std::size_t i = 0; i < entries.size(); ++i) {
-    png_text& t = texts[i];
-    std::memset(&t, 0, sizeof t);
-    t.compression = entries[i].second.size() > 1024 ? PNG_ITXT_COMPRESSION_zTXt : PNG_ITXT_COMPRESSION_NONE;
-    t.key = entries[i].first.data();
-    t.text = entries[i].second.data();
-    t.itxt_length = entries[i].second.size();
-    t.lang = nullptr;
-    t.lang_key = nullptr;
-  }
-
-  std::vector<png_byte> encoded;
-  PngErrorState err{};
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_png_error, on_png_warning);
-  if (png == nullptr) throw FileWriteError("cannot write '" + path.string() + "': libpng initialisation failed");
-  png_infop info = png_create_info_struct(png);
-  if (info == nullptr) {
-    png_destroy_write_struct(&png, nullptr);
-    throw FileWriteError("cannot write '" + path.string() + "': libpng initialisation failed");
-  }
-  png_set_write_fn(png, &encoded, on_png_write, on_png_flush);
-  const bool ok = encode_png(png, info, static_cast<png_uint_32>(w), static_cast<png_uint_32>(h), options.bit_depth,
-                             rows.data(), texts.data(), static_cast<int>(texts.size()));
-  png_destroy_write_struct(&png, &info);
-  if (!ok) throw FileWriteError("cannot write '" + path.string() + "': libpng: " + err.message);
-
-  AtomicFile::write_file(path, encoded.data(), encoded.size());
+  write_png_rows(path, w, h, options.bit_depth, rows.data(), entries);
   return report;
+}
+
+void write_png_rgb8(const std::filesystem::path& path, int width, int height, const std::vector<std::uint8_t>& rgb,
+                    const std::map<std::string, std::string>& text) {
+  if (width < 1 || height < 1 || rgb.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3)
+    throw std::invalid_argument("write_png_rgb8: " + std::to_string(rgb.size()) + " bytes for " +
+                                std::to_string(width) + " x " + std::to_string(height) + " RGB pixels");
+  std::vector<png_bytep> rows(static_cast<std::size_t>(height));
+  auto* data = const_cast<png_byte*>(rgb.data());  // libpng's row pointers are not const; it only reads them
+  for (int y = 0; y < height; ++y) rows[static_cast<std::size_t>(y)] = data + static_cast<std::size_t>(y) * width * 3;
+  std::vector<std::pair<std::string, std::string>> entries;
+  for (const auto& [key, value] : text) entries.emplace_back(png_keyword(key), value);
+  write_png_rows(path, width, height, 8, rows.data(), entries);
 }
 
 PngFile read_png(const std::filesystem::path& path) {

@@ -1,5 +1,6 @@
 // PNG output of an Image: a display-referred sRGB preview of the absolute
-// linear RGB, via libpng; and a reader for tests and tools.
+// linear RGB, via libpng; 8-bit display-space pixels as they are
+// (write_png_rgb8); and a reader for tests and tools.
 //
 // Parameters (PngWriteOptions)
 //   exposure_ev      EV100, the photographic exposure value at ISO 100
@@ -75,6 +76,14 @@ double auto_exposure_ev(const Image& image, double percentile = 0.5);
 // Throws std::invalid_argument for bad options, FileWriteError if the file
 // cannot be written.
 PngWriteReport write_png(const Image& image, const std::filesystem::path& path, const PngWriteOptions& options = {});
+
+// Writes 8-bit sRGB-encoded pixels as they are (interleaved RGB, top row
+// first; width * height * 3 bytes), with the same chunks as write_png and
+// `text` as iTXt chunks: for images drawn in display space (contact sheets).
+// Throws std::invalid_argument for a size mismatch, FileWriteError if the
+// file cannot be written.
+void write_png_rgb8(const std::filesystem::path& path, int width, int height, const std::vector<std::uint8_t>& rgb,
+                    const std::map<std::string, std::string>& text = {});
 
 // --- Reading (tests and tools) ---------------------------------------------
 struct PngFile {
