@@ -20,26 +20,12 @@
 #include "server/job_store.h"
 #include "server/tile_merger.h"
 
+#include "server/job_ids.h"
+
 namespace skyfarm::server {
 namespace {
 
 namespace fs = std::filesystem;
-
-double unix_now() {
-  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
-}
-
-std::string random_id() {
-  static std::mutex mu;
-  static std::mt19937_64 rng(std::random_device{}() ^ static_cast<std::uint64_t>(unix_now() * 1e6));
-  const std::lock_guard<std::mutex> lock(mu);
-  std::ostringstream o;
-  o << std::hex;
-  o.width(16);
-  o.fill('0');
-  o << rng();
-  return o.str();
-}
 
 // The result-cache key: the canonical request without its priority (which
 // changes when a job runs, not what it renders), hashed.
