@@ -31,6 +31,7 @@
 #include "server/http_checks.h"
 #include "server/http_metrics.h"
 #include "tests/server/fake_backend.h"
+#include "tests/support/http_fixture.h"
 
 namespace skyfarm::server {
 namespace {
@@ -143,27 +144,10 @@ HttpOptions test_options() {
   return o;
 }
 
-class HttpApiTest : public ::testing::Test {
+class HttpApiTest : public testing::HttpFixture {
  protected:
   void start(HttpOptions options = test_options()) {
-    api_ = std::make_unique<HttpApi>(backend_, std::move(options));
-    server_ = std::make_unique<httplib::Server>();
-    api_->register_routes(*server_);
-    port_ = server_->bind_to_any_port("127.0.0.1");
-    ASSERT_GT(port_, 0);
-    thread_ = std::thread([this] { server_->listen_after_bind(); });
-    for (int i = 0; i < 2000 && !server_->is_running(); ++i) std::this_thread::sleep_for(1ms);
-    ASSERT_TRUE(server_->is_running());
-  }
-  void TearDown() override {
-    if (server_) server_->stop();
-    if (thread_.joinable()) thread_.join();
-  }
-  httplib::Client client() const {
-    httplib::Client c("127.0.0.1", port_);
-    c.set_connection_timeout(2);
-    c.set_read_timeout(5);
-    return c;
+    serve(std::move(options));
   }
   httplib::Result post(const std::string& body, httplib::Headers headers = {},
                        const std::string& type = "application/json") {
@@ -188,11 +172,6 @@ class HttpApiTest : public ::testing::Test {
     return dir / name;
   }
 
-  FakeBackend backend_;
-  std::unique_ptr<HttpApi> api_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  int port_ = 0;
 };
 
 // --- Submit -------------------------------------------------------------------

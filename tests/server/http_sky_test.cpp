@@ -24,6 +24,7 @@
 #include "tests/support/coarse_lut.h"
 #include "server/http_api.h"
 #include "tests/server/fake_backend.h"
+#include "tests/support/http_fixture.h"
 #include "tests/server/probe_workers.h"
 #include "api/probe_answer.h"
 
@@ -40,11 +41,12 @@ constexpr const char* kLookup = "/v1/sky?sun_zenith=30&sun_azimuth=180&view_zeni
 
 nlohmann::json json_of(const httplib::Result& r) { return nlohmann::json::parse(r->body); }
 
-class SkyHttpTest : public ::testing::Test {
+class SkyHttpTest : public testing::HttpFixture {
  protected:
   void start(std::optional<std::string> token = std::nullopt, SkyServiceOptions sky = {},
              std::shared_ptr<ProbeService> probes = nullptr,
              std::chrono::milliseconds probe_timeout = std::chrono::seconds(60)) {
+    read_timeout_s_ = 30;  // cold env maps and path probes
     sky.resolution = coarse();
     sky.envmap_threads = 2;
     service_ = std::make_shared<SkyService>(sky);
@@ -53,24 +55,7 @@ class SkyHttpTest : public ::testing::Test {
     o.token = std::move(token);
     o.probes = std::move(probes);
     o.probe_timeout = probe_timeout;
-    api_ = std::make_unique<HttpApi>(backend_, std::move(o));
-    server_ = std::make_unique<httplib::Server>();
-    api_->register_routes(*server_);
-    port_ = server_->bind_to_any_port("127.0.0.1");
-    ASSERT_GT(port_, 0);
-    thread_ = std::thread([this] { server_->listen_after_bind(); });
-    for (int i = 0; i < 2000 && !server_->is_running(); ++i) std::this_thread::sleep_for(1ms);
-    ASSERT_TRUE(server_->is_running());
-  }
-  void TearDown() override {
-    if (server_) server_->stop();
-    if (thread_.joinable()) thread_.join();
-  }
-  httplib::Client client() const {
-    httplib::Client c("127.0.0.1", port_);
-    c.set_connection_timeout(2);
-    c.set_read_timeout(30);
-    return c;
+    serve(std::move(o));
   }
   // A 400 problem whose errors name `field` (the query parameter).
   void expect_bad(const std::string& path, const std::string& field) {
@@ -92,12 +77,7 @@ class SkyHttpTest : public ::testing::Test {
     return f;
   }
 
-  testing::FakeBackend backend_;
   std::shared_ptr<SkyService> service_;
-  std::unique_ptr<HttpApi> api_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  int port_ = 0;
 };
 
 TEST_F(SkyHttpTest, LookupAnswersSpectrumColourAndIsCached) {

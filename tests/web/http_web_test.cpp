@@ -15,6 +15,7 @@
 
 #include "server/http_api.h"
 #include "tests/server/fake_backend.h"
+#include "tests/support/http_fixture.h"
 #include "tests/support/test_files.h"
 
 namespace skyfarm::server {
@@ -26,34 +27,12 @@ using skyfarm::testing::read_text;
 
 const fs::path kWebDir = fs::path(SKYFARM_SOURCE_DIR) / "server" / "web";
 
-class HttpWebTest : public ::testing::Test {
+class HttpWebTest : public testing::HttpFixture {
  protected:
   void start(HttpOptions options = {}) {
-    api_ = std::make_unique<HttpApi>(backend_, std::move(options));
-    server_ = std::make_unique<httplib::Server>();
-    api_->register_routes(*server_);
-    port_ = server_->bind_to_any_port("127.0.0.1");
-    ASSERT_GT(port_, 0);
-    thread_ = std::thread([this] { server_->listen_after_bind(); });
-    for (int i = 0; i < 2000 && !server_->is_running(); ++i) std::this_thread::sleep_for(1ms);
-    ASSERT_TRUE(server_->is_running());
-  }
-  void TearDown() override {
-    if (server_) server_->stop();
-    if (thread_.joinable()) thread_.join();
-  }
-  httplib::Client client() const {
-    httplib::Client c("127.0.0.1", port_);
-    c.set_connection_timeout(2);
-    c.set_read_timeout(5);
-    return c;
+    serve(std::move(options));
   }
 
-  testing::FakeBackend backend_;
-  std::unique_ptr<HttpApi> api_;
-  std::unique_ptr<httplib::Server> server_;
-  std::thread thread_;
-  int port_ = 0;
 };
 
 void expect_file(const httplib::Result& r, const std::string& file, const std::string& type) {
