@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "server/timelapse_video.h"
@@ -58,19 +59,31 @@ std::string text_of(WebDriver& driver, const std::string& css) {
       .get<std::string>();
 }
 
-TEST(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
-  const auto programs = WebDriver::find_programs();
-  if (!programs) GTEST_SKIP() << kSkipMessage;
-  const fs::path dir = fresh_dir("page");
-  FarmServer server(dir / "data", 1);
-  ASSERT_TRUE(server.ok()) << server.log();
-  WebDriver driver(*programs);
-  ASSERT_TRUE(driver.ok()) << driver.error();
-  const std::string page = "http://127.0.0.1:" + std::to_string(server.port()) + "/";
+// Each test: a farm with one local worker (its own data folder) and headless
+// Chromium on the page, app.js started; skipped without Chromium.  The
+// browser goes before the server (members end in reverse order).
+class WebPage : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto programs = WebDriver::find_programs();
+    if (!programs) GTEST_SKIP() << kSkipMessage;
+    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    server_.emplace(fresh_dir(name) / "data", 1);
+    ASSERT_TRUE(server_->ok()) << server_->log();
+    driver_.emplace(*programs);
+    ASSERT_TRUE(driver_->ok()) << driver_->error();
+    driver_->navigate("http://127.0.0.1:" + std::to_string(server_->port()) + "/");
+    ASSERT_TRUE(driver_->wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
+        << "app.js did not start\n" << driver_->log();
+  }
 
-  driver.navigate(page);
-  ASSERT_TRUE(driver.wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
-      << "app.js did not start\n" << driver.log();
+  std::optional<FarmServer> server_;
+  std::optional<WebDriver> driver_;
+};
+
+TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
 
   // The server's 400 problem, shown next to the field it names; no job made.
   driver.type("#latitude", "95");
@@ -147,18 +160,9 @@ TEST(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   EXPECT_EQ(log.find("Content Security Policy"), std::string::npos) << log;
 }
 
-TEST(WebPage, TimelapseSubmittedFromThePageFillsTheStripPlaysAndIsListedDone) {
-  const auto programs = WebDriver::find_programs();
-  if (!programs) GTEST_SKIP() << kSkipMessage;
-  const fs::path dir = fresh_dir("timelapse");
-  FarmServer server(dir / "data", 1);
-  ASSERT_TRUE(server.ok()) << server.log();
-  WebDriver driver(*programs);
-  ASSERT_TRUE(driver.ok()) << driver.error();
-
-  driver.navigate("http://127.0.0.1:" + std::to_string(server.port()) + "/");
-  ASSERT_TRUE(driver.wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
-      << "app.js did not start\n" << driver.log();
+TEST_F(WebPage, TimelapseSubmittedFromThePageFillsTheStripPlaysAndIsListedDone) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
   driver.click(driver.find("input[name='kind'][value='timelapse']"));
   ASSERT_TRUE(driver.wait_until("return document.body.dataset.kind === 'timelapse';", kPageTimeout)) << driver.log();
   EXPECT_FALSE(driver.execute("return document.querySelector('#time-end').offsetParent === null;").get<bool>())
@@ -216,7 +220,8 @@ TEST(WebPage, TimelapseSubmittedFromThePageFillsTheStripPlaysAndIsListedDone) {
 
   // Play: the shown frame moves on; Pause stops it.
   const std::string first_caption = text_of(driver, "#tl-frame-caption");
-  EXPECT_NE(first_caption.find("Frame 1 of 4: 2021-06-21T12:00:00+02:00"), std::string::npos) << first_caption;
+  // The first frame to arrive is shown (the fetches run in parallel).
+  EXPECT_NE(first_caption.find(" of 4: 2021-06-21T1"), std::string::npos) << first_caption;
   driver.click(driver.find("#tl-play"));
   EXPECT_TRUE(driver.wait_until("return document.querySelector('#tl-frame-caption').textContent !== " +
                                     js_string(first_caption) + " && document.querySelector('#tl-seek').value !== '0';",
