@@ -4,16 +4,16 @@
 
 #include <algorithm>
 #include <ctime>
-#include <fstream>
 #include <limits>
 #include <thread>
-#include <vector>
 
 #include "api/json_fields.h"
 #include "api/render_request.h"
 #include "server/http_checks.h"
+#include "server/http_files.h"
 #include "server/http_openapi.h"
 #include "server/http_probe.h"
+#include "server/http_query.h"
 #include "server/http_problem.h"
 #include "server/http_sky.h"
 #include "server/http_web.h"
@@ -56,15 +56,10 @@ constexpr std::size_t kKeepAliveMaxCount = 100;
 constexpr std::time_t kKeepAliveTimeoutS = 3;
 constexpr int kMinSpareThreads = 4;        // beyond the stream slots, whatever http_threads says
 constexpr int kStreamRetryAfterS = 5;      // 503 when every stream slot is taken
-constexpr std::uint64_t kMaxOffset = 1000000000;
-constexpr std::uint64_t kDefaultLimit = 20;
-constexpr std::uint64_t kMaxLimit = 100;
 
 const char* const kIdRoute = R"(/v1/renders/([^/]+))";
 // Catch-all for methods with a body: the fallback must not read it.
 const char* const kAnyPath = R"([\s\S]*)";
-
-std::string quote_text(std::string_view text) { return "\"" + printable_excerpt(text) + "\""; }
 
 std::string render_path(const std::string& id) { return "/v1/renders/" + id; }
 
@@ -137,20 +132,6 @@ HttpError not_found(const std::string& id) {
   return http_error(404, "there is no render with id \"" + id + "\"");
 }
 
-// An optional query parameter given at most once, an integer in [lo, hi].
-std::uint64_t query_number(const Request& req, const char* name, std::uint64_t fallback, std::uint64_t lo,
-                           std::uint64_t hi) {
-  const std::size_t count = req.get_param_value_count(name);
-  if (count == 0) return fallback;
-  if (count > 1) throw invalid_parameter(name, "must be given once", std::to_string(count) + " values");
-  const std::string text = req.get_param_value(name);
-  const auto value = parse_decimal(text, hi);
-  if (!value || *value < lo)
-    throw invalid_parameter(name, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]",
-                            quote_text(text));
-  return *value;
-}
-
 void check_media_type(const Request& req) {
   const std::string type = req.get_header_value("Content-Type");
   std::string detail;
@@ -206,18 +187,6 @@ std::string generic_detail(int status, std::size_t max_body_bytes) {
 // A file served in chunks (images can be tens of MB); the stream stays open on
 // the file the backend named, so a newer preview renamed over it meanwhile
 // does not mix two images.
-struct FileSource {
-  std::ifstream in;
-  std::vector<char> buffer = std::vector<char>(64 * 1024);
-
-  bool provide(std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-    const std::size_t n = std::min(length, buffer.size());
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(buffer.data(), static_cast<std::streamsize>(n));
-    if (static_cast<std::size_t>(in.gcount()) != n) return false;
-    return sink.write(buffer.data(), n);
-  }
-};
 
 }  // namespace
 
@@ -402,11 +371,11 @@ void HttpApi::submit(const Request& req, Response& res, const ContentReader& rea
 }
 
 void HttpApi::list(const Request& req, Response& res) {
-  const std::uint64_t offset = query_number(req, "offset", 0, 0, kMaxOffset);
-  const std::uint64_t limit = query_number(req, "limit", kDefaultLimit, 1, kMaxLimit);
-  nlohmann::json renders = backend_.list(offset, limit);
+  const Page page = page_of(req);
+  nlohmann::json renders = backend_.list(page.offset, page.limit);
   const std::size_t total = backend_.job_count();
-  send_json(res, 200, {{"renders", std::move(renders)}, {"offset", offset}, {"limit", limit}, {"total", total}});
+  send_json(res, 200,
+            {{"renders", std::move(renders)}, {"offset", page.offset}, {"limit", page.limit}, {"total", total}});
 }
 
 void HttpApi::status(const Request& req, Response& res) {
@@ -441,29 +410,10 @@ void HttpApi::image(const Request& req, Response& res, ImageFormat format) {
                ") has no image: its first pass has not covered the whole frame yet";
     throw HttpError(std::move(p));
   }
-  const char* cache_final = options_.token ? "private, max-age=31536000, immutable"  // never in shared caches
-                                           : "public, max-age=31536000, immutable";
-  res.set_header("ETag", file->etag);
-  res.set_header("Cache-Control", file->final ? cache_final : "no-cache");
-  if (if_none_match_matches(req.get_header_value("If-None-Match"), file->etag)) {
-    res.status = 304;
-    return;
-  }
-  auto source = std::make_shared<FileSource>();
-  source->in.open(file->path, std::ios::binary);
-  source->in.seekg(0, std::ios::end);
-  const std::streamoff size = source->in ? static_cast<std::streamoff>(source->in.tellg()) : -1;
-  if (!source->in || size < 0) {
-    log_server_error("GET " + req.path, "cannot read " + file->path.string());
-    throw http_error(500, "the image file of render \"" + id + "\" could not be read");
-  }
   const bool exr = format == ImageFormat::kExr;
-  res.set_header("Content-Disposition", "inline; filename=\"" + id + (exr ? ".exr\"" : ".png\""));
-  res.status = 200;
-  res.set_content_provider(static_cast<std::size_t>(size), exr ? "image/x-exr" : "image/png",
-                           [source](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-                             return source->provide(offset, length, sink);
-                           });
+  send_file(req, res, *file,
+            {exr ? "image/x-exr" : "image/png", id + (exr ? ".exr" : ".png"), final_cache_control(options_.token.has_value()),
+             "the image file of render \"" + id + "\" could not be read"});
 }
 
 void HttpApi::events(const Request& req, Response& res) {

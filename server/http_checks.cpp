@@ -141,4 +141,6 @@ std::string printable_excerpt(std::string_view text, std::size_t max_chars) {
   return out;
 }
 
+std::string quote_text(std::string_view text) { return std::string("\"") + printable_excerpt(text) + "\""; }
+
 }  // namespace skyfarm::server

@@ -50,5 +50,7 @@ bool if_none_match_matches(std::string_view if_none_match, std::string_view etag
 
 // Text safe to echo in a message: at most `max_chars`, control characters as '?'.
 std::string printable_excerpt(std::string_view text, std::size_t max_chars = 80);
+// The excerpt in double quotes: how a request part is echoed in an error.
+std::string quote_text(std::string_view text);
 
 }  // namespace skyfarm::server

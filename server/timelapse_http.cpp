@@ -2,13 +2,13 @@
 
 #include <httplib.h>
 
-#include <fstream>
-#include <memory>
-#include <vector>
+#include <cstdio>
 
 #include "api/timelapse_request.h"
 #include "server/http_checks.h"
+#include "server/http_files.h"
 #include "server/http_problem.h"
+#include "server/http_query.h"
 
 namespace skyfarm::server {
 namespace {
@@ -19,14 +19,9 @@ using httplib::Response;
 
 inline constexpr std::string_view kProblemNotReady = "urn:skyfarm:problem:timelapse-file-not-ready";
 inline constexpr std::string_view kProblemVideoUnavailable = "urn:skyfarm:problem:video-unavailable";
-constexpr std::uint64_t kMaxOffset = 1000000000;
-constexpr std::uint64_t kDefaultLimit = 20;
-constexpr std::uint64_t kMaxLimit = 100;
 constexpr std::uint64_t kMaxFrameIndex = 999999;
 
 const char* const kIdRoute = R"(/v1/timelapses/([^/]+))";
-
-std::string quote_text(std::string_view text) { return std::string("\"") + printable_excerpt(text) + "\""; }
 
 std::string id_of(const Request& req) {
   std::string id = req.matches.size() > 1 ? req.matches[1].str() : std::string();
@@ -35,35 +30,6 @@ std::string id_of(const Request& req) {
 }
 
 HttpError not_found(const std::string& id) { return http_error(404, "there is no timelapse with id \"" + id + "\""); }
-
-// An optional query parameter given at most once, an integer in [lo, hi].
-std::uint64_t query_number(const Request& req, const char* name, std::uint64_t fallback, std::uint64_t lo,
-                           std::uint64_t hi) {
-  const std::size_t count = req.get_param_value_count(name);
-  if (count == 0) return fallback;
-  if (count > 1) throw invalid_parameter(name, "must be given once", std::to_string(count) + " values");
-  const std::string text = req.get_param_value(name);
-  const auto value = parse_decimal(text, hi);
-  if (!value || *value < lo)
-    throw invalid_parameter(name, "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]",
-                            quote_text(text));
-  return *value;
-}
-
-// A file streamed in chunks from the stream opened now, so that a newer
-// file renamed over it meanwhile does not mix two versions.
-struct FileBody {
-  std::ifstream in;
-  std::vector<char> buffer = std::vector<char>(64 * 1024);
-
-  bool provide(std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-    const std::size_t n = std::min(length, buffer.size());
-    in.seekg(static_cast<std::streamoff>(offset));
-    in.read(buffer.data(), static_cast<std::streamsize>(n));
-    if (static_cast<std::size_t>(in.gcount()) != n) return false;
-    return sink.write(buffer.data(), n);
-  }
-};
 
 }  // namespace
 
@@ -83,7 +49,7 @@ std::optional<std::string_view> timelapse_allowed_methods(std::string_view path)
 
 TimelapseHttp::TimelapseHttp(TimelapseService& service, bool private_cache)
     : service_(service),
-      cache_final_(private_cache ? "private, max-age=31536000, immutable" : "public, max-age=31536000, immutable") {}
+      cache_final_(final_cache_control(private_cache)) {}
 
 void TimelapseHttp::add_routes(httplib::Server& server, Hooks hooks) {
   hooks_ = std::move(hooks);
@@ -124,11 +90,12 @@ void TimelapseHttp::submit(const Request& req, Response& res, const ContentReade
 }
 
 void TimelapseHttp::list(const Request& req, Response& res) const {
-  const std::uint64_t offset = query_number(req, "offset", 0, 0, kMaxOffset);
-  const std::uint64_t limit = query_number(req, "limit", kDefaultLimit, 1, kMaxLimit);
-  nlohmann::json timelapses = service_.list(offset, limit);
-  send_json(res, 200,
-            {{"timelapses", std::move(timelapses)}, {"offset", offset}, {"limit", limit}, {"total", service_.count()}});
+  const Page page = page_of(req);
+  nlohmann::json timelapses = service_.list(page.offset, page.limit);
+  send_json(res, 200, {{"timelapses", std::move(timelapses)},
+                       {"offset", page.offset},
+                       {"limit", page.limit},
+                       {"total", service_.count()}});
 }
 
 void TimelapseHttp::status(const Request& req, Response& res) const {
@@ -199,27 +166,8 @@ void TimelapseHttp::send(const Request& req, Response& res, const TimelapseFile&
       throw HttpError(std::move(p));
     }
   }
-  const ImageFile& f = *file.file;
-  res.set_header("ETag", f.etag);
-  res.set_header("Cache-Control", f.final ? cache_final_ : "no-cache");
-  if (if_none_match_matches(req.get_header_value("If-None-Match"), f.etag)) {
-    res.status = 304;
-    return;
-  }
-  auto body = std::make_shared<FileBody>();
-  body->in.open(f.path, std::ios::binary);
-  body->in.seekg(0, std::ios::end);
-  const std::streamoff size = body->in ? static_cast<std::streamoff>(body->in.tellg()) : -1;
-  if (!body->in || size < 0) {
-    log_server_error("GET " + req.path, "cannot read " + f.path.string());
-    throw http_error(500, "a file of timelapse \"" + id + "\" could not be read");
-  }
-  res.set_header("Content-Disposition", "inline; filename=\"" + filename + "\"");
-  res.status = 200;
-  res.set_content_provider(static_cast<std::size_t>(size), content_type,
-                           [body](std::size_t offset, std::size_t length, httplib::DataSink& sink) {
-                             return body->provide(offset, length, sink);
-                           });
+  send_file(req, res, *file.file,
+            {content_type, filename, cache_final_, "a file of timelapse \"" + id + "\" could not be read"});
 }
 
 }  // namespace skyfarm::server

@@ -8,7 +8,10 @@
 //   GET  /v1/renders/{id}[/image.png]         status, progressive image (409 until the
 //                                             first pass is merged)
 //   GET  /v1/renders, /v1/timelapses, /v1/workers   the lists, every kListRefreshMs
-//   GET  /v1/timelapses/{id}[/frames/{n}.png]  timelapse status (polled) and frames
+//   GET  /v1/timelapses/{id}[/frames/{n}.png]  timelapse status (polled) and frames: a
+//                                             frame's render PNG once its render is done,
+//                                             fetched again once the timelapse is done
+//                                             (then exposed as the sequence is)
 //   DELETE /v1/renders/{id}, /v1/timelapses/{id}   cancel
 //
 // Every request carries "Authorization: Bearer <token>" when a token was
@@ -609,7 +612,8 @@ const lapse = {
   id: null,
   timer: null,
   status: null,
-  frames: new Map(),     // index -> {url, time, state}; url once the PNG is fetched
+  frames: new Map(),     // index -> {url, time, state, final}; url once the PNG is fetched,
+                         // final once fetched from a done timelapse (it will not change)
   fetching: new Set(),
   shown: 0,
   player: null,
@@ -680,11 +684,13 @@ function drawFiles(status) {
   const videoLink = $("#tl-video"), sheetLink = $("#tl-sheet");
   videoLink.hidden = !video.available;
   if (video.available) setDownload(videoLink, status.links?.video || `${base}/video.mp4`, `${id}.mp4`);
-  const done = status.state === "done";
-  sheetLink.hidden = !done;
-  if (done) setDownload(sheetLink, status.links?.contact_sheet || `${base}/contact_sheet.png`, `${id}-sheet.png`);
-  $("#tl-files-note").textContent = !video.available && video.reason ? `No video: ${video.reason}` :
-    done ? "" : "The contact sheet and the video come when every frame is done.";
+  const sheet = status.contact_sheet?.available === true;
+  sheetLink.hidden = !sheet;
+  if (sheet) setDownload(sheetLink, status.links?.contact_sheet || `${base}/contact_sheet.png`, `${id}-contact-sheet.png`);
+  // The status says why there is no video (yet): no ffmpeg, being made, frames to go.
+  const over = kTerminal.has(status.state);
+  $("#tl-files-note").textContent = !video.available && video.reason ? `${over ? "No video" : "Video"}: ${video.reason}` :
+    over ? "" : "The contact sheet and the video come when every frame is done.";
 }
 
 function syncStrip(frames) {
@@ -708,27 +714,47 @@ function syncStrip(frames) {
     });
 }
 
-// Fetches the PNG of every finished frame not fetched yet, a few at a time.
+// Fetches the PNG of every finished frame not fetched yet, a few at a time;
+// once the timelapse is done, each frame once more: its PNG is then the
+// sequence's (one smoothed exposure) instead of the frame render's own.
+// A failed fetch is tried again at the next poll, or after kTimelapsePollMs
+// when the timelapse is over (nothing polls then).
 function fetchFrames(frames) {
   const id = lapse.id;
+  const final = lapse.status?.state === "done";
   const base = `/v1/timelapses/${encodeURIComponent(id)}/frames`;
   for (const f of frames) {
     const entry = lapse.frames.get(f.index);
-    if (f.state !== "done" || entry.url || lapse.fetching.has(f.index)) continue;
+    if (f.state !== "done" || (entry.url && (entry.final || !final)) || lapse.fetching.has(f.index)) continue;
     if (lapse.fetching.size >= kThumbnailFetches) break;
     lapse.fetching.add(f.index);
     fetchBlobUrl(`${base}/${f.index}.png`, lapse.abort.signal).then((blob) => {
       if (lapse.id !== id) { if (blob.url) URL.revokeObjectURL(blob.url); return; }
       lapse.fetching.delete(f.index);
       if (blob.url) {
-        lapse.frames.get(f.index).url = blob.url;
-        const li = [...$("#tl-strip").children].find((node) => node.dataset.key === String(f.index));
-        if (li) { li.querySelector("img").src = blob.url; li.querySelector(".thumb-label").textContent = ""; }
-        if (!$("#tl-frame").getAttribute("src")) showFrame(f.index);
+        frameFetched(f.index, blob.url, final);
+        fetchFrames(lapse.status?.frames || []);
+      } else if (kTerminal.has(lapse.status?.state)) {
+        setTimeout(() => { if (lapse.id === id) fetchFrames(lapse.status?.frames || []); }, kTimelapsePollMs);
       }
-      fetchFrames(lapse.status?.frames || []);
     }).catch(() => {});
   }
+}
+
+// A frame's PNG arrived: its thumbnail, and the big view when it shows that
+// frame or nothing yet.
+function frameFetched(index, url, final) {
+  const entry = lapse.frames.get(index);
+  const old = entry.url;
+  Object.assign(entry, { url, final });
+  const li = [...$("#tl-strip").children].find((node) => node.dataset.key === String(index));
+  if (li) {
+    li.querySelector("img").src = url;
+    li.querySelector(".thumb-label").textContent = "";
+    li.dataset.exposure = final ? "sequence" : "frame";  // which PNG the thumbnail is
+  }
+  if (!$("#tl-frame").getAttribute("src") || lapse.shown === index) showFrame(index);
+  if (old) URL.revokeObjectURL(old);
 }
 
 function showFrame(index) {

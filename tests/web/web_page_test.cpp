@@ -4,14 +4,20 @@
 // invalid latitude is refused by the server and the page shows the problem
 // next to the field; a small render typed in and submitted with Enter is
 // shown live until its image has loaded and its state is done; the render
-// list and the worker list show it and the worker.  Skipped (with the command
-// that installs them) when Chromium or chromedriver is missing.
+// list and the worker list show it and the worker.  A small LUT timelapse
+// chosen and submitted in the form is followed until every frame of the strip
+// has loaded (exposed as the sequence is), plays (the shown frame changes),
+// offers its contact sheet and its video (or, without ffmpeg, says why not)
+// and is listed done.  Skipped (with the command that installs them) when
+// Chromium or chromedriver is missing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <string>
 
+#include "server/timelapse_video.h"
 #include "tests/farm/farm_process.h"
 #include "tests/support/webdriver.h"
 
@@ -38,11 +44,13 @@ fs::path fresh_dir(const std::string& name) {
 // A JavaScript string literal.
 std::string js_string(const std::string& text) { return nlohmann::json(text).dump(); }
 
-// Sets a datetime-local input the way its picker would (typing into one
-// depends on the browser's locale), firing the events the page listens to.
-void set_date_time(WebDriver& driver, const std::string& css, const std::string& value) {
+// Sets a datetime-local input or a select the way its picker would (typing
+// into a datetime-local depends on the browser's locale), firing the events
+// the page listens to.
+void set_value(WebDriver& driver, const std::string& css, const std::string& value) {
   driver.execute("const e = document.querySelector(arguments[0]); e.value = arguments[1];"
-                 "e.dispatchEvent(new Event('input', {bubbles: true}));",
+                 "e.dispatchEvent(new Event('input', {bubbles: true}));"
+                 "e.dispatchEvent(new Event('change', {bubbles: true}));",
                  {css, value});
 }
 
@@ -51,19 +59,31 @@ std::string text_of(WebDriver& driver, const std::string& css) {
       .get<std::string>();
 }
 
-TEST(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
-  const auto programs = WebDriver::find_programs();
-  if (!programs) GTEST_SKIP() << kSkipMessage;
-  const fs::path dir = fresh_dir("page");
-  FarmServer server(dir / "data", 1);
-  ASSERT_TRUE(server.ok()) << server.log();
-  WebDriver driver(*programs);
-  ASSERT_TRUE(driver.ok()) << driver.error();
-  const std::string page = "http://127.0.0.1:" + std::to_string(server.port()) + "/";
+// Each test: a farm with one local worker (its own data folder) and headless
+// Chromium on the page, app.js started; skipped without Chromium.  The
+// browser goes before the server (members end in reverse order).
+class WebPage : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto programs = WebDriver::find_programs();
+    if (!programs) GTEST_SKIP() << kSkipMessage;
+    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    server_.emplace(fresh_dir(name) / "data", 1);
+    ASSERT_TRUE(server_->ok()) << server_->log();
+    driver_.emplace(*programs);
+    ASSERT_TRUE(driver_->ok()) << driver_->error();
+    driver_->navigate("http://127.0.0.1:" + std::to_string(server_->port()) + "/");
+    ASSERT_TRUE(driver_->wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
+        << "app.js did not start\n" << driver_->log();
+  }
 
-  driver.navigate(page);
-  ASSERT_TRUE(driver.wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
-      << "app.js did not start\n" << driver.log();
+  std::optional<FarmServer> server_;
+  std::optional<WebDriver> driver_;
+};
+
+TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
 
   // The server's 400 problem, shown next to the field it names; no job made.
   driver.type("#latitude", "95");
@@ -81,7 +101,7 @@ TEST(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   // when the page subscribes to its events.
   driver.type("#latitude", "48.85");
   driver.type("#longitude", "2.35");
-  set_date_time(driver, "#time-local", "2021-06-21T13:50");
+  set_value(driver, "#time-local", "2021-06-21T13:50");
   driver.type("#time-zone", "Europe/Paris");
   EXPECT_EQ(driver.execute("return document.querySelector('#time-preview').value;"), "2021-06-21T13:50:00+02:00");
   driver.type("#width", "32");
@@ -134,6 +154,113 @@ TEST(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
       << driver.log();
   const std::string worker_cores = driver.execute("return document.querySelector('#workers-body tr').cells[1].textContent;");
   EXPECT_NE(worker_cores, "–") << "the worker row shows its cores";
+
+  const std::string log = driver.log();
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
+  EXPECT_EQ(log.find("Content Security Policy"), std::string::npos) << log;
+}
+
+TEST_F(WebPage, TimelapseSubmittedFromThePageFillsTheStripPlaysAndIsListedDone) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
+  driver.click(driver.find("input[name='kind'][value='timelapse']"));
+  ASSERT_TRUE(driver.wait_until("return document.body.dataset.kind === 'timelapse';", kPageTimeout)) << driver.log();
+  EXPECT_FALSE(driver.execute("return document.querySelector('#time-end').offsetParent === null;").get<bool>())
+      << "the end time is shown for a timelapse";
+
+  // Four LUT frames of 32x16 over Paris, 12:00 to 15:00 local time, an hour apart.
+  driver.type("#latitude", "48.85");
+  driver.type("#longitude", "2.35");
+  set_value(driver, "#time-local", "2021-06-21T12:00");
+  set_value(driver, "#time-end", "2021-06-21T15:00");
+  driver.type("#time-zone", "Europe/Paris");
+  set_value(driver, "#split-kind", "frames");
+  driver.type("#split-value", "4");
+  driver.type("#width", "32");
+  driver.type("#height", "16");
+  set_value(driver, "#method", "lut");
+  driver.click(driver.find("#submit"));
+
+  // Done, and every thumbnail loaded from the done timelapse's own PNGs.
+  const bool filled = driver.wait_until(
+      "const items = [...document.querySelectorAll('#tl-strip li')];"
+      "return document.querySelector('#tl-state').textContent === 'done' && items.length === 4 &&"
+      "  items.every((li) => { const img = li.querySelector('img');"
+      "    return li.dataset.exposure === 'sequence' && img.complete && img.naturalWidth > 0; });",
+      kRenderTimeout);
+  const std::string id = text_of(driver, "#tl-id");
+  ASSERT_TRUE(filled) << "timelapse " << id << " state '" << text_of(driver, "#tl-state") << "', "
+                      << text_of(driver, "#tl-summary") << "; strip: "
+                      << driver.execute("return [...document.querySelectorAll('#tl-strip li')].map("
+                                        "(li) => li.textContent + '/' + li.dataset.exposure);")
+                             .dump()
+                      << "\n" << driver.log();
+  ASSERT_FALSE(id.empty());
+  EXPECT_EQ(driver.execute("return location.hash;"), "#timelapse=" + id);
+  EXPECT_EQ(driver.execute("return [...document.querySelectorAll('#tl-strip img')].map((i) => [i.naturalWidth, i.naturalHeight]);"),
+            nlohmann::json::parse("[[32,16],[32,16],[32,16],[32,16]]"));
+  // The thumbnails show the done timelapse's frame PNGs (the sequence's
+  // exposure): the same pixels as the served files, drawn on a canvas.
+  EXPECT_EQ(driver.execute(
+                "const pixels = (img) => { const c = document.createElement('canvas');"
+                "  c.width = img.naturalWidth; c.height = img.naturalHeight;"
+                "  const g = c.getContext('2d'); g.drawImage(img, 0, 0);"
+                "  return g.getImageData(0, 0, c.width, c.height).data.join(); };"
+                "const served = (i) => new Promise((ok, fail) => { const img = new Image();"
+                "  img.onload = () => ok(pixels(img)); img.onerror = fail; img.src = arguments[0] + i + '.png'; });"
+                "const imgs = [...document.querySelectorAll('#tl-strip img')];"
+                "return Promise.all(imgs.map((img, i) => served(i).then((p) => p === pixels(img))));",
+                {"/v1/timelapses/" + id + "/frames/"}),
+            nlohmann::json::parse("[true,true,true,true]"));
+  EXPECT_EQ(text_of(driver, "#tl-summary"), "4 of 4 frames · 100 %");
+  ASSERT_TRUE(driver.wait_until("const img = document.querySelector('#tl-frame');"
+                                "return img.complete && img.naturalWidth === 32;",
+                                kPageTimeout))
+      << "the first frame is shown large\n" << driver.log();
+
+  // Play: the shown frame moves on; Pause stops it.
+  const std::string first_caption = text_of(driver, "#tl-frame-caption");
+  // The first frame to arrive is shown (the fetches run in parallel).
+  EXPECT_NE(first_caption.find(" of 4: 2021-06-21T1"), std::string::npos) << first_caption;
+  driver.click(driver.find("#tl-play"));
+  EXPECT_TRUE(driver.wait_until("return document.querySelector('#tl-frame-caption').textContent !== " +
+                                    js_string(first_caption) + " && document.querySelector('#tl-seek').value !== '0';",
+                                kPageTimeout))
+      << "the shown frame did not change: " << text_of(driver, "#tl-frame-caption") << "\n" << driver.log();
+  EXPECT_EQ(driver.execute("return document.querySelector('#tl-play').getAttribute('aria-pressed');"), "true");
+  driver.click(driver.find("#tl-play"));
+  EXPECT_EQ(driver.execute("return document.querySelector('#tl-play').getAttribute('aria-pressed');"), "false");
+
+  // The files, fetched as the links point: the contact sheet always; the video
+  // when ffmpeg is installed, else the status's reason on the page.
+  const std::string base = "/v1/timelapses/" + id;
+  const std::string fetch_link =
+      "const a = document.querySelector(arguments[0]); if (a.hidden) return 'hidden';"
+      "return fetch(a.href).then((r) => new URL(a.href).pathname + ' ' + r.status + ' ' + r.headers.get('Content-Type'));";
+  EXPECT_EQ(driver.execute(fetch_link, {"#tl-sheet"}), base + "/contact_sheet.png 200 image/png");
+  const auto answer = server.client().Get(("/v1/timelapses/" + id).c_str());
+  ASSERT_TRUE(answer && answer->status == 200);
+  const nlohmann::json status = nlohmann::json::parse(answer->body);
+  if (server::find_ffmpeg("").path) {
+    EXPECT_EQ(driver.execute(fetch_link, {"#tl-video"}), base + "/video.mp4 200 video/mp4") << status["video"].dump();
+  } else {
+    EXPECT_EQ(driver.execute(fetch_link, {"#tl-video"}), "hidden");
+    EXPECT_EQ(text_of(driver, "#tl-files-note"), "No video: " + status["video"]["reason"].get<std::string>());
+  }
+
+  // The farm agrees: that timelapse, with the request the form described.
+  EXPECT_EQ(status["state"], "done") << status.dump();
+  EXPECT_EQ(status["method"], "lut");
+  EXPECT_EQ(status["frames"].size(), 4u);
+  EXPECT_EQ(status["frames"][3]["time"], "2021-06-21T15:00:00+02:00");
+  EXPECT_EQ(status["request"]["camera"]["width"], 32);
+
+  // The timelapse list (refreshed by the page) has it, done.
+  const std::string row = js_string("#timelapses-body tr[data-key=\"" + id + "\"]");
+  EXPECT_TRUE(driver.wait_until("const row = document.querySelector(" + row + ");"
+                                "return !!row && row.cells[1].textContent === 'done' && row.cells[2].textContent === '4 of 4';",
+                                kPageTimeout))
+      << driver.log();
 
   const std::string log = driver.log();
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
