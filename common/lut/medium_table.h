@@ -76,13 +76,6 @@ class MediumTable {
   // Interpolated coefficients at a located altitude, out[b] for b < bins.
   void sigma_t(Node n, double* out) const { interpolate(sigma_t_, n, bins_, out); }
   void sigma_s(Node n, double* out) const { interpolate(sigma_s_, n, bins_, out); }
-  // acc[b] += weight * sigma_t[b] (the transmittance quadrature).
-  void add_sigma_t(Node n, double weight, double* acc) const {
-    const double* a = sigma_t_.data() + n.i * static_cast<std::size_t>(bins_);
-    const double* b = a + bins_;
-    const double w0 = weight * (1.0 - n.f), w1 = weight * n.f;
-    for (int k = 0; k < bins_; ++k) acc[k] += w0 * a[k] + w1 * b[k];
-  }
   // All scatterers at once: out[c * bins + b].
   void sigma_s_per_scatterer(Node n, double* out) const { interpolate(sigma_s_c_, n, scatterers_ * bins_, out); }
 

@@ -31,7 +31,9 @@
 // approach to the centre (radius l = r sqrt(1 - mu^2)), r(s) = sqrt(l^2 + s^2);
 // each monotone part [s_a, s_b] (s_a >= 0) is mapped by s = s_a + (s_b -
 // s_a) u^2, so that the samples crowd where the air is densest, and the
-// optical depth int sigma_t ds is summed by Simpson's rule in u.
+// optical depth int sigma_t ds is summed by Simpson's rule in u, for each of
+// the medium's extinction terms (medium_table.h: 7 profiles for the Earth,
+// whatever the number of bins), then expanded to the bins once per node.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -40,6 +42,7 @@
 
 #include "common/lut/bilinear.h"
 #include "common/lut/medium_table.h"
+#include "common/lut/vector_math.h"
 
 namespace skyfarm {
 
@@ -49,9 +52,14 @@ class TransmittanceLut {
 
   // Where (r, mu) falls in the table, in two parts: the radius part
   // (locate_r, reused for every mu at that radius) and the fractional node
-  // position u in [0, mu_samples - 1] along mu (mu_position: inline and
-  // branch-free so that loops over many mu vectorise), -1 for a ray that
-  // meets the ground (T = 0).
+  // position u in [0, mu_samples - 1] along mu (mu_position), -1 for a ray
+  // that meets the ground (T = 0).  mu_position is inline and has a single
+  // select so that the loops over many mu (a table row's views, every sun
+  // of the multiple-scattering table) vectorise: the ground test is d >
+  // d_max, i.e. x_mu > 1 before clamping (the distance to the top grows as
+  // mu falls, and the horizon ray has d_max), which is lut::ray_hits_ground
+  // up to rounding (the 1e-12 margin keeps the horizontal ray from the
+  // ground, mu = 0, unblocked).
   struct RadiusCoord {
     double r, r2, top_c, ground_c;  // r, r^2, R_top^2 - r^2, r^2 - R^2 (as (a - b)(a + b))
     double d_min, inv_range;        // R_top - r, 1 / (d_max - d_min)
@@ -60,12 +68,11 @@ class TransmittanceLut {
   };
   RadiusCoord locate_r(double r) const;
   double mu_position(const RadiusCoord& rc, double mu) const {
-    const double r2mu2 = rc.r2 * mu * mu;
-    const double d = -rc.r * mu + std::sqrt(std::max(0.0, r2mu2 + rc.top_c));  // distance to the top
-    const double x_mu = std::min(1.0, std::max(0.0, (d - rc.d_min) * rc.inv_range));
-    const double u = (1.0 - std::sqrt(std::sqrt(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
-    const bool hits_ground = (mu < 0.0) & (r2mu2 >= rc.ground_c);             // lut::ray_hits_ground
-    return hits_ground ? -1.0 : u;
+    const double d = -rc.r * mu + lut::sqrt_inline(rc.r2 * mu * mu + rc.top_c);  // distance to the top
+    const double x = (d - rc.d_min) * rc.inv_range;
+    const double x_mu = std::min(1.0, std::max(0.0, x));
+    const double u = (1.0 - lut::sqrt_inline(lut::sqrt_inline(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
+    return x > 1.0 + 1e-12 ? -1.0 : u;
   }
   // The four nodes and weights around (rc, u >= 0), for fused loops.
   lut::Bilinear bilinear(const RadiusCoord& rc, double u) const {
@@ -73,6 +80,21 @@ class TransmittanceLut {
     const std::size_t B = static_cast<std::size_t>(bins_);
     return lut::Bilinear(values_.data() + rc.row + i * B, static_cast<std::size_t>(n_mu_) * B, B, rc.fj,
                          u - static_cast<double>(i));
+  }
+  // The radius half of that interpolation for the mu nodes [first, first +
+  // count): out[m * bins + b] = T at rc's radius and node first + m.  A
+  // march step whose many views fall on few nodes builds these once and
+  // interpolates along mu only (node_of(u), then linear).
+  void radius_rows(const RadiusCoord& rc, std::size_t first, std::size_t count, double* __restrict out) const {
+    const std::size_t B = static_cast<std::size_t>(bins_), n = count * B;
+    const double* __restrict a = values_.data() + rc.row + first * B;
+    const double* __restrict b = a + static_cast<std::size_t>(n_mu_) * B;
+    const double f = rc.fj, g = 1.0 - f;
+    for (std::size_t k = 0; k < n; ++k) out[k] = g * a[k] + f * b[k];
+  }
+  // The node i (u in [i, i + 1]) that bilinear() interpolates from, u >= 0.
+  std::size_t node_of(double u) const {
+    return std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_ - 2));
   }
   // T per bin (bilinear; 0 when u < 0).
   void lookup(const RadiusCoord& rc, double u, double* out) const;
