@@ -43,6 +43,12 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   std::vector<TransmittanceLut::RadiusCoord> rc(D * S);
   std::vector<double> a(D * S), bcoef(D * S), a_g(D), b_g(D), t_mid(S), dt(S);
   std::vector<char> hits(D);
+  const std::size_t M = static_cast<std::size_t>(mu_s_samples);
+  std::vector<double> mu_s(M), sin_s(M), u_T(M), L_all(M * B);
+  for (std::size_t col = 0; col < M; ++col) {
+    mu_s[col] = -1.0 + 2.0 * static_cast<double>(col) / static_cast<double>(M - 1);
+    sin_s[col] = std::sqrt(std::max(0.0, 1.0 - mu_s[col] * mu_s[col]));
+  }
   for (int j = 0; j < altitude_samples; ++j) {
     const double r = R + m.top_altitude_ * j / (altitude_samples - 1);
     std::fill(f_ms.begin(), f_ms.end(), 0.0);
@@ -85,20 +91,28 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         ++m.clamped_;
       }
     }
-    for (int col = 0; col < mu_s_samples; ++col) {
-      const double mu_s = -1.0 + 2.0 * col / (mu_s_samples - 1), sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
-      std::fill(L.begin(), L.end(), 0.0);
-      for (std::size_t q = 0; q < D * S; ++q) {
-        const double mu_q = std::clamp(a[q] * sin_s + bcoef[q] * mu_s, -1.0, 1.0);
-        const double u = transmittance.mu_position(rc[q], mu_q);
-        if (u >= 0.0) transmittance.bilinear(rc[q], u).weighted_add(m.bins_, W.data() + q * B, L.data());
+    // Single scattering towards x from every sample, for every sun (column)
+    // at once: the samples outside, so that the two transmittance rows of a
+    // sample's radius stay in cache while all columns read them.
+    std::fill(L_all.begin(), L_all.end(), 0.0);
+    for (std::size_t q = 0; q < D * S; ++q) {
+      for (std::size_t col = 0; col < M; ++col) {
+        const double mu_q = std::min(1.0, std::max(-1.0, a[q] * sin_s[col] + bcoef[q] * mu_s[col]));
+        u_T[col] = transmittance.mu_position(rc[q], mu_q);
       }
+      for (std::size_t col = 0; col < M; ++col)
+        if (u_T[col] >= 0.0)
+          transmittance.bilinear(rc[q], u_T[col]).weighted_add(m.bins_, W.data() + q * B, L_all.data() + col * B);
+    }
+    for (std::size_t col = 0; col < M; ++col) {
+      std::copy(L_all.begin() + static_cast<std::ptrdiff_t>(col * B),
+                L_all.begin() + static_cast<std::ptrdiff_t>((col + 1) * B), L.begin());
       for (std::size_t b = 0; b < B; ++b) L[b] *= kInv4Pi;  // the sun's phase p_u
       // The ground's Lambertian reflection of the attenuated sun (Hillaire's code,
       // IntegrateScatteredLuminance "bounced light off the earth").
       for (std::size_t i = 0; i < D; ++i) {
         if (!hits[i]) continue;
-        const double mu_g = std::clamp(a_g[i] * sin_s + b_g[i] * mu_s, -1.0, 1.0);
+        const double mu_g = std::clamp(a_g[i] * sin_s[col] + b_g[i] * mu_s[col], -1.0, 1.0);
         if (mu_g <= 0.0) continue;
         transmittance.lookup(ground_rc, transmittance.mu_position(ground_rc, mu_g), T_sun.data());
         for (std::size_t b = 0; b < B; ++b) L[b] += T_ground[i * B + b] * T_sun[b] * mu_g * albedo[b] * kInvPi;

@@ -57,6 +57,18 @@ class MultipleScatteringLut {
     return lut::Bilinear(values_.data() + a.row + k * B, static_cast<std::size_t>(n_mu_s_) * B, B, a.fj,
                          u - static_cast<double>(k));
   }
+  // The altitude half of that interpolation for the mu_s nodes [first,
+  // first + count): out[m * bins + b] (TransmittanceLut::radius_rows).
+  void altitude_rows(const AltitudeCoord& a, std::size_t first, std::size_t count, double* __restrict out) const {
+    const std::size_t B = static_cast<std::size_t>(bins_), n = count * B;
+    const double* __restrict v0 = values_.data() + a.row + first * B;
+    const double* __restrict v1 = v0 + static_cast<std::size_t>(n_mu_s_) * B;
+    const double f = a.fj, g = 1.0 - f;
+    for (std::size_t k = 0; k < n; ++k) out[k] = g * v0[k] + f * v1[k];
+  }
+  std::size_t node_of(double u) const {
+    return std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_s_ - 2));
+  }
   // Psi_ms per bin (bilinear).
   void lookup(const AltitudeCoord& a, double u, double* out) const;
   // acc[b] += weight[b] * Psi_ms[b].

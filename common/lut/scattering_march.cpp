@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "common/core/constants.h"
 #include "common/lut/ground_irradiance_lut.h"
@@ -11,6 +12,9 @@
 namespace skyfarm {
 
 namespace {
+
+// Views per tile in add_inscattering.
+constexpr std::size_t kViewTile = 32;
 
 // L[b] += (w0 p0 + c1 w1 p1)[b] T_sun[b] + w_ms[b] Psi[b], T_sun and Psi
 // bilinear from their tables: the sky-view build's innermost loop, one pass
@@ -31,6 +35,42 @@ inline void add_source(std::size_t B, double* __restrict L, const double* w0, co
   }
 }
 
+// One step through a segment, per bin: T1 = T0 T_seg and w = T0 int_seg
+// exp(-sigma_t s) ds.  (Separate restrict-qualified arrays, so that the loop
+// vectorises without run-time alias checks.)
+inline void segment_weights(std::size_t B, const double* __restrict T0, const double* __restrict sigma_t, double dt,
+                            double* __restrict T1, double* __restrict w) {
+  for (std::size_t b = 0; b < B; ++b) {
+    double integral;
+    T1[b] = T0[b] * lut::T_and_in_scattering_integral(sigma_t[b], dt, &integral);
+    w[b] = T0[b] * integral;
+  }
+}
+
+inline void multiply(std::size_t B, const double* __restrict a, const double* __restrict b, double* __restrict out) {
+  for (std::size_t k = 0; k < B; ++k) out[k] = a[k] * b[k];
+}
+
+// The same with T and Psi linear between two of the rows that radius_rows
+// and altitude_rows built for the step: t, t + B and m, m + B.
+inline void add_source_rows(std::size_t B, double* __restrict L, const double* w0, const double* p0, const double* w1,
+                            const double* p1, double c1, const double* t, double ft, const double* m, double fm,
+                            const double* w_ms) {
+  const double gt = 1.0 - ft, gm = 1.0 - fm;
+  for (std::size_t b = 0; b < B; ++b) {
+    const double T_sun = gt * t[b] + ft * t[B + b];
+    const double psi = gm * m[b] + fm * m[B + b];
+    L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
+  }
+}
+
+// L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
+// whose point the planet hides from the sun.
+inline void add_weighted_row(std::size_t B, double* __restrict L, const double* m, double f, const double* w) {
+  const double g = 1.0 - f;
+  for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
+}
+
 }  // namespace
 
 ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceLut& transmittance,
@@ -48,6 +88,11 @@ ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceL
   s_c_.resize(C * B);
   w_phase_.resize(B);
   tmp_.resize(B);
+  u_T_.resize(kViewTile);
+  u_ms_.resize(kViewTile);
+  // At most kViewTile rows in each (add_step builds rows only then).
+  rows_T_.resize(kViewTile * B);
+  rows_M_.resize(kViewTile * B);
 }
 
 void ScatteringMarch::prepare(double r0, double mu, double t_end, bool ends_on_ground, int steps) {
@@ -74,6 +119,7 @@ void ScatteringMarch::prepare_boundaries(double r0, double mu, std::span<const d
 
 // The sun-independent part: per step the coefficients at the midpoint, the
 // segment's transmittance and in-scattering integral, and the weights.
+SKYFARM_LUT_SIMD_CLONES
 void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t S = static_cast<std::size_t>(steps_);
@@ -99,65 +145,107 @@ void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
     medium_.sigma_t(node, s_t_.data());
     medium_.sigma_s(node, s_s_.data());
     medium_.sigma_s_per_scatterer(node, s_c_.data());
-    const double* T0 = T_before_.data() + k * B;
-    double* T1 = T_before_.data() + (k + 1) * B;
-    double* wms = w_ms_.data() + k * B;
-    double* wc = w_c_.data() + k * C * B;
-    for (std::size_t b = 0; b < B; ++b) {
-      double integral;
-      T1[b] = T0[b] * lut::T_and_in_scattering_integral(s_t_[b], dt_[k], &integral);
-      const double w = T0[b] * integral;
-      wms[b] = w * s_s_[b];
-      for (std::size_t c = 0; c < C; ++c) wc[c * B + b] = w * s_c_[c * B + b];
-    }
+    const double* T0 = T_before(static_cast<int>(k));
+    double* w = tmp_.data();
+    segment_weights(B, T0, s_t_.data(), dt_[k], T_before_.data() + (k + 1) * B, w);
+    multiply(B, w, s_s_.data(), w_ms_.data() + k * B);
+    for (std::size_t c = 0; c < C; ++c) multiply(B, w, s_c_.data() + c * B, w_c_.data() + (k * C + c) * B);
   }
 }
 
-SKYFARM_LUT_SIMD_CLONES
 void ScatteringMarch::add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1,
                                        double* L) const {
+  if (mu0_.size() < static_cast<std::size_t>(std::max(0, n))) mu0_.resize(static_cast<std::size_t>(n));
+  std::fill(mu0_.begin(), mu0_.begin() + std::max(0, n), mu_s0);
+  add_inscattering(n, nu, mu0_.data(), phase, k0, k1, L);
+}
+
+// Views in tiles of kViewTile, all steps per tile: a tile's phase values,
+// radiance and the table rows its views read stay in the L1 cache.
+void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0,
+                                       int k1, double* L) const {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t N = static_cast<std::size_t>(std::max(0, n));
-  if (u_T_.size() < N) {
-    u_T_.resize(N);
-    u_ms_.resize(N);
+  for (std::size_t first = 0; first < N; first += kViewTile) {
+    const std::size_t m = std::min(kViewTile, N - first);
+    for (int k = std::max(0, k0); k < std::min(k1, steps_); ++k)
+      add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase + first * C * B, L + first * B);
   }
-  double* u_T = u_T_.data();
-  double* u_ms = u_ms_.data();
-  for (int kk = std::max(0, k0); kk < std::min(k1, steps_); ++kk) {
-    const std::size_t k = static_cast<std::size_t>(kk);
-    const TransmittanceLut::RadiusCoord rc = radius_[k];
-    const double a = c_mu_[k] * mu_s0, c = c_nu_[k];
-    // Where each view's mu_s(t_k) falls in the transmittance and multiple-
-    // scattering tables (u_T < 0: the planet hides the sun).
-    const double ms_nodes = ms_ ? ms_->mu_s_samples() - 1 : 0.0;
-    for (std::size_t i = 0; i < N; ++i) {
-      const double mu_s = std::min(1.0, std::max(-1.0, a + c * nu[i]));
-      u_T[i] = transmittance_.mu_position(rc, mu_s);
-      u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
-    }
-    const double* wc = w_c_.data() + k * C * B;
-    const double* wms = w_ms_.data() + k * B;
-    for (std::size_t i = 0; i < N; ++i) {
-      double* Li = L + i * B;
-      const double* p = phase + i * C * B;
-      // One fused pass over the bins: J = T_sun sum_c w_c p_c + w_ms Psi_ms.
-      const bool lit = u_T[i] >= 0.0;
-      if (lit && ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer
-        const lut::Bilinear t = transmittance_.bilinear(rc, u_T[i]), m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
-        const double* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
-        const double* p1 = C == 2 ? p + B : p;
-        add_source(B, Li, wc, p, wc1, p1, C == 2 ? 1.0 : 0.0, t, wms, m);
-        continue;
+}
+
+// One step for up to kViewTile views.
+SKYFARM_LUT_SIMD_CLONES
+void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0,
+                                      const double* phase, double* L) const {
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  const TransmittanceLut::RadiusCoord rc = radius_[k];
+  const double a = c_mu_[k], c = c_nu_[k];
+  // Where each view's mu_s(t_k) falls in the transmittance and multiple-
+  // scattering tables (u_T < 0: the planet hides the sun).
+  const double ms_nodes = ms_ ? ms_->mu_s_samples() - 1 : 0.0;
+  double *__restrict u_T = u_T_.data(), *__restrict u_ms = u_ms_.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double mu_s = std::min(1.0, std::max(-1.0, a * mu_s0[i] + c * nu[i]));
+    u_T[i] = transmittance_.mu_position(rc, mu_s);
+    u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
+  }
+  const double* wc = w_c_.data() + k * C * B;
+  const double* wms = w_ms_.data() + k * B;
+  if (ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer: one fused pass per view
+    const double* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
+    const double c1 = C == 2 ? 1.0 : 0.0;
+    // The nodes the views fall on: when they are fewer than the views,
+    // interpolate the tables to this step's radius once (radius_rows).
+    std::size_t t_lo = SIZE_MAX, t_hi = 0, m_lo = SIZE_MAX, m_hi = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (u_T[i] >= 0.0) {
+        t_lo = std::min(t_lo, transmittance_.node_of(u_T[i]));
+        t_hi = std::max(t_hi, transmittance_.node_of(u_T[i]));
       }
-      if (lit && C > 0) {  // the general case: any number of scatterers, with or without Psi_ms
-        for (std::size_t b = 0; b < B; ++b) w_phase_[b] = wc[b] * p[b];
-        for (std::size_t cc = 1; cc < C; ++cc)
-          for (std::size_t b = 0; b < B; ++b) w_phase_[b] += wc[cc * B + b] * p[cc * B + b];
-        transmittance_.lookup_weighted_add(rc, u_T[i], w_phase_.data(), Li);
-      }
-      if (ms_) ms_->lookup_weighted_add(ms_altitude_[k], u_ms[i], wms, Li);
+      m_lo = std::min(m_lo, ms_->node_of(u_ms[i]));
+      m_hi = std::max(m_hi, ms_->node_of(u_ms[i]));
     }
+    const std::size_t t_rows = t_lo <= t_hi ? t_hi - t_lo + 2 : 0, m_rows = m_hi - m_lo + 2;
+    if (t_rows + m_rows <= n) {
+      double *T_rows = rows_T_.data(), *M_rows = rows_M_.data();
+      if (t_rows > 0) transmittance_.radius_rows(rc, t_lo, t_rows, T_rows);
+      ms_->altitude_rows(ms_altitude_[k], m_lo, m_rows, M_rows);
+      for (std::size_t i = 0; i < n; ++i) {
+        const std::size_t jm = ms_->node_of(u_ms[i]);
+        const double* M = M_rows + (jm - m_lo) * B;
+        const double fm = u_ms[i] - static_cast<double>(jm);
+        if (u_T[i] >= 0.0) {
+          const std::size_t jt = transmittance_.node_of(u_T[i]);
+          const double* p = phase + i * C * B;
+          add_source_rows(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, T_rows + (jt - t_lo) * B,
+                          u_T[i] - static_cast<double>(jt), M, fm, wms);
+        } else {
+          add_weighted_row(B, L + i * B, M, fm, wms);
+        }
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const lut::Bilinear m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
+      if (u_T[i] >= 0.0) {
+        const double* p = phase + i * C * B;
+        add_source(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, transmittance_.bilinear(rc, u_T[i]), wms, m);
+      } else {
+        m.weighted_add(bins_, wms, L + i * B);
+      }
+    }
+    return;
+  }
+  for (std::size_t i = 0; i < n; ++i) {  // the general case: any number of scatterers, with or without Psi_ms
+    double* Li = L + i * B;
+    const double* p = phase + i * C * B;
+    if (u_T[i] >= 0.0 && C > 0) {
+      for (std::size_t b = 0; b < B; ++b) w_phase_[b] = wc[b] * p[b];
+      for (std::size_t cc = 1; cc < C; ++cc)
+        for (std::size_t b = 0; b < B; ++b) w_phase_[b] += wc[cc * B + b] * p[cc * B + b];
+      transmittance_.lookup_weighted_add(rc, u_T[i], w_phase_.data(), Li);
+    }
+    if (ms_) ms_->lookup_weighted_add(ms_altitude_[k], u_ms[i], wms, Li);
   }
 }
 

@@ -59,11 +59,17 @@ class ScatteringMarch {
   // L + i * bins.  The look-up positions of all n views are computed in one
   // vectorisable pass per step.
   void add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1, double* L) const;
+  // The same with a sun per view: mu_s0[i] (the ground-irradiance table's
+  // suns, one per view).
+  void add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0, int k1,
+                        double* L) const;
   // L[b] += the ground's reflected radiance times T(x_0, x_g), if the ray ends on it.
   void add_ground(double nu, double mu_s0, double* L) const;
 
  private:
   void prepare_steps(double r0, double mu, bool ends_on_ground);
+  void add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const double* phase,
+                double* L) const;
 
   const MediumTable& medium_;
   const TransmittanceLut& transmittance_;
@@ -81,7 +87,7 @@ class ScatteringMarch {
   std::vector<double> c_mu_, c_nu_;      // mu_s(t_k) = c_mu mu_s0 + c_nu nu
   std::vector<double> s_t_, s_s_, s_c_;  // scratch per step
   // Scratch of the look-ups (a ScatteringMarch is used by one thread at a time).
-  mutable std::vector<double> w_phase_, tmp_, u_T_, u_ms_;
+  mutable std::vector<double> w_phase_, tmp_, u_T_, u_ms_, mu0_, rows_T_, rows_M_;
 };
 
 }  // namespace skyfarm
