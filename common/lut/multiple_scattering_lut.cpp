@@ -31,7 +31,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   const std::size_t B = static_cast<std::size_t>(m.bins_), S = static_cast<std::size_t>(steps);
   const std::size_t D = static_cast<std::size_t>(directions);
   const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
-  m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0);
+  m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0f);
   const std::vector<glm::dvec3> dirs = lut::fibonacci_sphere(directions);
   const std::vector<double>& albedo = medium.ground_albedo();
   const TransmittanceLut::RadiusCoord ground_rc = transmittance.locate_r(R);
@@ -39,12 +39,15 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   // Per altitude row, everything that does not depend on the sun: the
   // weights T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of every step,
   // the step's T-LUT radius, and mu_s at the step as a sin_s + b mu_s.
-  std::vector<double> W(D * S * B), T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
+  // (W and the sums over the samples in single precision, as the tables: bilinear.h.)
+  std::vector<float> W(D * S * B);
+  std::vector<double> T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
   std::vector<TransmittanceLut::RadiusCoord> rc(D * S);
   std::vector<double> a(D * S), bcoef(D * S), a_g(D), b_g(D), t_mid(S), dt(S);
   std::vector<char> hits(D);
   const std::size_t M = static_cast<std::size_t>(mu_s_samples);
-  std::vector<double> mu_s(M), sin_s(M), u_T(M), L_all(M * B);
+  std::vector<double> mu_s(M), sin_s(M), u_T(M);
+  std::vector<float> L_all(M * B);
   for (std::size_t col = 0; col < M; ++col) {
     mu_s[col] = -1.0 + 2.0 * static_cast<double>(col) / static_cast<double>(M - 1);
     sin_s[col] = std::sqrt(std::max(0.0, 1.0 - mu_s[col] * mu_s[col]));
@@ -64,12 +67,13 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         const MediumTable::Node node = medium.locate(rk - R);
         medium.sigma_t(node, s_t.data());
         medium.sigma_s(node, s_s.data());
-        double* Wk = W.data() + (i * S + k) * B;
+        float* Wk = W.data() + (i * S + k) * B;
         for (std::size_t b = 0; b < B; ++b) {
           double integral;
           const double T_seg = lut::T_and_in_scattering_integral(s_t[b], dt[k], &integral);
-          Wk[b] = T_acc[b] * integral * s_s[b];
-          f_ms[b] += Wk[b];
+          const double w = T_acc[b] * integral * s_s[b];
+          Wk[b] = static_cast<float>(w);
+          f_ms[b] += w;
           T_acc[b] *= T_seg;
         }
         rc[i * S + k] = transmittance.locate_r(rk);
@@ -94,7 +98,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
     // Single scattering towards x from every sample, for every sun (column)
     // at once: the samples outside, so that the two transmittance rows of a
     // sample's radius stay in cache while all columns read them.
-    std::fill(L_all.begin(), L_all.end(), 0.0);
+    std::fill(L_all.begin(), L_all.end(), 0.0f);
     for (std::size_t q = 0; q < D * S; ++q) {
       for (std::size_t col = 0; col < M; ++col) {
         const double mu_q = std::min(1.0, std::max(-1.0, a[q] * sin_s[col] + bcoef[q] * mu_s[col]));
@@ -117,8 +121,8 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         transmittance.lookup(ground_rc, transmittance.mu_position(ground_rc, mu_g), T_sun.data());
         for (std::size_t b = 0; b < B; ++b) L[b] += T_ground[i * B + b] * T_sun[b] * mu_g * albedo[b] * kInvPi;
       }
-      double* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
-      for (std::size_t b = 0; b < B; ++b) out[b] = (L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]);
+      float* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
+      for (std::size_t b = 0; b < B; ++b) out[b] = static_cast<float>((L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]));
     }
   }
   return m;

@@ -16,23 +16,49 @@ namespace {
 // Views per tile in add_inscattering.
 constexpr std::size_t kViewTile = 32;
 
+// The sums over the steps are in single precision, like the tables they
+// read (bilinear.h): a step's weights, the views' phase values and their
+// partial sums are floats, added to the caller's doubles once per call.
+
 // L[b] += (w0 p0 + c1 w1 p1)[b] T_sun[b] + w_ms[b] Psi[b], T_sun and Psi
 // bilinear from their tables: the sky-view build's innermost loop, one pass
 // over the bins.  (__restrict: L never overlaps the tables or weights;
 // without it the loop needs more run-time alias checks than GCC emits, and
 // stays scalar.)
-inline void add_source(std::size_t B, double* __restrict L, const double* w0, const double* p0, const double* w1,
-                       const double* p1, double c1, const lut::Bilinear& t, const double* w_ms,
-                       const lut::Bilinear& m) {
-  const double *t00 = t.v00, *t01 = t.v01, *t10 = t.v10, *t11 = t.v11;
-  const double *m00 = m.v00, *m01 = m.v01, *m10 = m.v10, *m11 = m.v11;
-  const double tw00 = t.w00, tw01 = t.w01, tw10 = t.w10, tw11 = t.w11;
-  const double mw00 = m.w00, mw01 = m.w01, mw10 = m.w10, mw11 = m.w11;
+inline void add_source(std::size_t B, float* __restrict L, const float* w0, const float* p0, const float* w1,
+                       const float* p1, float c1, const lut::BilinearF& t, const float* w_ms,
+                       const lut::BilinearF& m) {
+  const float *t00 = t.v00, *t01 = t.v01, *t10 = t.v10, *t11 = t.v11;
+  const float *m00 = m.v00, *m01 = m.v01, *m10 = m.v10, *m11 = m.v11;
+  const float tw00 = static_cast<float>(t.w00), tw01 = static_cast<float>(t.w01), tw10 = static_cast<float>(t.w10),
+              tw11 = static_cast<float>(t.w11);
+  const float mw00 = static_cast<float>(m.w00), mw01 = static_cast<float>(m.w01), mw10 = static_cast<float>(m.w10),
+              mw11 = static_cast<float>(m.w11);
   for (std::size_t b = 0; b < B; ++b) {
-    const double T_sun = tw00 * t00[b] + tw01 * t01[b] + tw10 * t10[b] + tw11 * t11[b];
-    const double psi = mw00 * m00[b] + mw01 * m01[b] + mw10 * m10[b] + mw11 * m11[b];
+    const float T_sun = tw00 * t00[b] + tw01 * t01[b] + tw10 * t10[b] + tw11 * t11[b];
+    const float psi = mw00 * m00[b] + mw01 * m01[b] + mw10 * m10[b] + mw11 * m11[b];
     L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
   }
+}
+
+// The same with T and Psi linear between two of the rows that radius_rows
+// and altitude_rows built for the step: t, t + B and m, m + B.
+inline void add_source_rows(std::size_t B, float* __restrict L, const float* w0, const float* p0, const float* w1,
+                            const float* p1, float c1, const float* t, float ft, const float* m, float fm,
+                            const float* w_ms) {
+  const float gt = 1.0f - ft, gm = 1.0f - fm;
+  for (std::size_t b = 0; b < B; ++b) {
+    const float T_sun = gt * t[b] + ft * t[B + b];
+    const float psi = gm * m[b] + fm * m[B + b];
+    L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
+  }
+}
+
+// L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
+// whose point the planet hides from the sun.
+inline void add_weighted_row(std::size_t B, float* __restrict L, const float* m, float f, const float* w) {
+  const float g = 1.0f - f;
+  for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
 }
 
 // One step through a segment, per bin: T1 = T0 T_seg and w = T0 int_seg
@@ -47,28 +73,8 @@ inline void segment_weights(std::size_t B, const double* __restrict T0, const do
   }
 }
 
-inline void multiply(std::size_t B, const double* __restrict a, const double* __restrict b, double* __restrict out) {
-  for (std::size_t k = 0; k < B; ++k) out[k] = a[k] * b[k];
-}
-
-// The same with T and Psi linear between two of the rows that radius_rows
-// and altitude_rows built for the step: t, t + B and m, m + B.
-inline void add_source_rows(std::size_t B, double* __restrict L, const double* w0, const double* p0, const double* w1,
-                            const double* p1, double c1, const double* t, double ft, const double* m, double fm,
-                            const double* w_ms) {
-  const double gt = 1.0 - ft, gm = 1.0 - fm;
-  for (std::size_t b = 0; b < B; ++b) {
-    const double T_sun = gt * t[b] + ft * t[B + b];
-    const double psi = gm * m[b] + fm * m[B + b];
-    L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
-  }
-}
-
-// L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
-// whose point the planet hides from the sun.
-inline void add_weighted_row(std::size_t B, double* __restrict L, const double* m, double f, const double* w) {
-  const double g = 1.0 - f;
-  for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
+inline void multiply(std::size_t B, const double* __restrict a, const double* __restrict b, float* __restrict out) {
+  for (std::size_t k = 0; k < B; ++k) out[k] = static_cast<float>(a[k] * b[k]);
 }
 
 }  // namespace
@@ -90,6 +96,8 @@ ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceL
   tmp_.resize(B);
   u_T_.resize(kViewTile);
   u_ms_.resize(kViewTile);
+  phase_f_.resize(kViewTile * C * B);
+  L_f_.resize(kViewTile * B);
   // At most kViewTile rows in each (add_step builds rows only then).
   rows_T_.resize(kViewTile * B);
   rows_M_.resize(kViewTile * B);
@@ -161,22 +169,26 @@ void ScatteringMarch::add_inscattering(int n, const double* nu, const double* ph
 }
 
 // Views in tiles of kViewTile, all steps per tile: a tile's phase values,
-// radiance and the table rows its views read stay in the L1 cache.
+// sums and the table rows its views read stay in the L1 cache.
 void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0,
                                        int k1, double* L) const {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t N = static_cast<std::size_t>(std::max(0, n));
   for (std::size_t first = 0; first < N; first += kViewTile) {
     const std::size_t m = std::min(kViewTile, N - first);
+    std::copy(phase + first * C * B, phase + (first + m) * C * B, phase_f_.begin());
+    std::fill(L_f_.begin(), L_f_.begin() + static_cast<std::ptrdiff_t>(m * B), 0.0f);
     for (int k = std::max(0, k0); k < std::min(k1, steps_); ++k)
-      add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase + first * C * B, L + first * B);
+      add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase_f_.data(), L_f_.data());
+    double* out = L + first * B;
+    for (std::size_t j = 0; j < m * B; ++j) out[j] += L_f_[j];
   }
 }
 
 // One step for up to kViewTile views.
 SKYFARM_LUT_SIMD_CLONES
-void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0,
-                                      const double* phase, double* L) const {
+void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const float* phase,
+                               float* L) const {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const TransmittanceLut::RadiusCoord rc = radius_[k];
   const double a = c_mu_[k], c = c_nu_[k];
@@ -189,11 +201,11 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
     u_T[i] = transmittance_.mu_position(rc, mu_s);
     u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
   }
-  const double* wc = w_c_.data() + k * C * B;
-  const double* wms = w_ms_.data() + k * B;
+  const float* wc = w_c_.data() + k * C * B;
+  const float* wms = w_ms_.data() + k * B;
   if (ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer: one fused pass per view
-    const double* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
-    const double c1 = C == 2 ? 1.0 : 0.0;
+    const float* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
+    const float c1 = C == 2 ? 1.0f : 0.0f;
     // The nodes the views fall on: when they are fewer than the views,
     // interpolate the tables to this step's radius once (radius_rows).
     std::size_t t_lo = SIZE_MAX, t_hi = 0, m_lo = SIZE_MAX, m_hi = 0;
@@ -207,18 +219,18 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
     }
     const std::size_t t_rows = t_lo <= t_hi ? t_hi - t_lo + 2 : 0, m_rows = m_hi - m_lo + 2;
     if (t_rows + m_rows <= n) {
-      double *T_rows = rows_T_.data(), *M_rows = rows_M_.data();
+      float *T_rows = rows_T_.data(), *M_rows = rows_M_.data();
       if (t_rows > 0) transmittance_.radius_rows(rc, t_lo, t_rows, T_rows);
       ms_->altitude_rows(ms_altitude_[k], m_lo, m_rows, M_rows);
       for (std::size_t i = 0; i < n; ++i) {
         const std::size_t jm = ms_->node_of(u_ms[i]);
-        const double* M = M_rows + (jm - m_lo) * B;
-        const double fm = u_ms[i] - static_cast<double>(jm);
+        const float* M = M_rows + (jm - m_lo) * B;
+        const float fm = static_cast<float>(u_ms[i] - static_cast<double>(jm));
         if (u_T[i] >= 0.0) {
           const std::size_t jt = transmittance_.node_of(u_T[i]);
-          const double* p = phase + i * C * B;
+          const float* p = phase + i * C * B;
           add_source_rows(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, T_rows + (jt - t_lo) * B,
-                          u_T[i] - static_cast<double>(jt), M, fm, wms);
+                          static_cast<float>(u_T[i] - static_cast<double>(jt)), M, fm, wms);
         } else {
           add_weighted_row(B, L + i * B, M, fm, wms);
         }
@@ -226,9 +238,9 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
       return;
     }
     for (std::size_t i = 0; i < n; ++i) {
-      const lut::Bilinear m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
+      const lut::BilinearF m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
       if (u_T[i] >= 0.0) {
-        const double* p = phase + i * C * B;
+        const float* p = phase + i * C * B;
         add_source(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, transmittance_.bilinear(rc, u_T[i]), wms, m);
       } else {
         m.weighted_add(bins_, wms, L + i * B);
@@ -236,16 +248,17 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
     }
     return;
   }
+  float* w_phase = w_phase_.data();
   for (std::size_t i = 0; i < n; ++i) {  // the general case: any number of scatterers, with or without Psi_ms
-    double* Li = L + i * B;
-    const double* p = phase + i * C * B;
+    float* Li = L + i * B;
+    const float* p = phase + i * C * B;
     if (u_T[i] >= 0.0 && C > 0) {
-      for (std::size_t b = 0; b < B; ++b) w_phase_[b] = wc[b] * p[b];
+      for (std::size_t b = 0; b < B; ++b) w_phase[b] = wc[b] * p[b];
       for (std::size_t cc = 1; cc < C; ++cc)
-        for (std::size_t b = 0; b < B; ++b) w_phase_[b] += wc[cc * B + b] * p[cc * B + b];
-      transmittance_.lookup_weighted_add(rc, u_T[i], w_phase_.data(), Li);
+        for (std::size_t b = 0; b < B; ++b) w_phase[b] += wc[cc * B + b] * p[cc * B + b];
+      transmittance_.bilinear(rc, u_T[i]).weighted_add(bins_, w_phase, Li);
     }
-    if (ms_) ms_->lookup_weighted_add(ms_altitude_[k], u_ms[i], wms, Li);
+    if (ms_) ms_->bilinear(ms_altitude_[k], u_ms[i]).weighted_add(bins_, wms, Li);
   }
 }
 

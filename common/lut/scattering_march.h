@@ -68,8 +68,8 @@ class ScatteringMarch {
 
  private:
   void prepare_steps(double r0, double mu, bool ends_on_ground);
-  void add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const double* phase,
-                double* L) const;
+  void add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const float* phase,
+                float* L) const;
 
   const MediumTable& medium_;
   const TransmittanceLut& transmittance_;
@@ -81,13 +81,15 @@ class ScatteringMarch {
   std::vector<double> t_mid_, dt_;
   // Per step: weights T(x_0, x_k-) int_k exp(-sigma_t s) ds sigma_s,c ([k][c][b])
   // and the same with the total sigma_s ([k][b]); T before each step ([k][b]).
-  std::vector<double> w_c_, w_ms_, T_before_;
+  std::vector<float> w_c_, w_ms_;  // single precision, as the tables they weight (bilinear.h)
+  std::vector<double> T_before_;
   std::vector<TransmittanceLut::RadiusCoord> radius_;
   std::vector<MultipleScatteringLut::AltitudeCoord> ms_altitude_;
   std::vector<double> c_mu_, c_nu_;      // mu_s(t_k) = c_mu mu_s0 + c_nu nu
   std::vector<double> s_t_, s_s_, s_c_;  // scratch per step
   // Scratch of the look-ups (a ScatteringMarch is used by one thread at a time).
-  mutable std::vector<double> w_phase_, tmp_, u_T_, u_ms_, mu0_, rows_T_, rows_M_;
+  mutable std::vector<double> tmp_, u_T_, u_ms_, mu0_;
+  mutable std::vector<float> w_phase_, phase_f_, L_f_, rows_T_, rows_M_;
 };
 
 }  // namespace skyfarm

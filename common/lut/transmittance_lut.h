@@ -63,7 +63,7 @@ class TransmittanceLut {
   struct RadiusCoord {
     double r, r2, top_c, ground_c;  // r, r^2, R_top^2 - r^2, r^2 - R^2 (as (a - b)(a + b))
     double d_min, inv_range;        // R_top - r, 1 / (d_max - d_min)
-    std::size_t row;                // offset of node (j, 0), in doubles
+    std::size_t row;                // offset of node (j, 0), in values
     double fj;                      // weight of row j + 1
   };
   RadiusCoord locate_r(double r) const;
@@ -75,21 +75,21 @@ class TransmittanceLut {
     return x > 1.0 + 1e-12 ? -1.0 : u;
   }
   // The four nodes and weights around (rc, u >= 0), for fused loops.
-  lut::Bilinear bilinear(const RadiusCoord& rc, double u) const {
+  lut::BilinearF bilinear(const RadiusCoord& rc, double u) const {
     const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_ - 2));
     const std::size_t B = static_cast<std::size_t>(bins_);
-    return lut::Bilinear(values_.data() + rc.row + i * B, static_cast<std::size_t>(n_mu_) * B, B, rc.fj,
-                         u - static_cast<double>(i));
+    return lut::BilinearF(values_.data() + rc.row + i * B, static_cast<std::size_t>(n_mu_) * B, B, rc.fj,
+                          u - static_cast<double>(i));
   }
   // The radius half of that interpolation for the mu nodes [first, first +
   // count): out[m * bins + b] = T at rc's radius and node first + m.  A
   // march step whose many views fall on few nodes builds these once and
   // interpolates along mu only (node_of(u), then linear).
-  void radius_rows(const RadiusCoord& rc, std::size_t first, std::size_t count, double* __restrict out) const {
+  void radius_rows(const RadiusCoord& rc, std::size_t first, std::size_t count, float* __restrict out) const {
     const std::size_t B = static_cast<std::size_t>(bins_), n = count * B;
-    const double* __restrict a = values_.data() + rc.row + first * B;
-    const double* __restrict b = a + static_cast<std::size_t>(n_mu_) * B;
-    const double f = rc.fj, g = 1.0 - f;
+    const float* __restrict a = values_.data() + rc.row + first * B;
+    const float* __restrict b = a + static_cast<std::size_t>(n_mu_) * B;
+    const float f = static_cast<float>(rc.fj), g = 1.0f - f;
     for (std::size_t k = 0; k < n; ++k) out[k] = g * a[k] + f * b[k];
   }
   // The node i (u in [i, i + 1]) that bilinear() interpolates from, u >= 0.
@@ -117,12 +117,12 @@ class TransmittanceLut {
 
   int mu_samples() const { return n_mu_; }
   int r_samples() const { return n_r_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(double); }
+  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
   int bins_ = 0, n_mu_ = 0, n_r_ = 0, steps_ = 0;
   double R_ = 0.0, R_top_ = 0.0, H_ = 0.0;
-  std::vector<double> values_;  // [x_r node][x_mu node][bin]
+  std::vector<float> values_;  // [x_r node][x_mu node][bin], single precision (bilinear.h)
 };
 
 }  // namespace skyfarm
