@@ -46,12 +46,12 @@ class SkyViewLut {
   void lookup(double mu, double cos_phi, double* out) const;
 
   const lut::ViewMapping& mapping() const { return mapping_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(double); }
+  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
   int bins_ = 0;
   lut::ViewMapping mapping_;
-  std::vector<double> values_;  // [row][column][bin]
+  std::vector<float> values_;  // [row][column][bin], single precision (2.7 MB instead of 5.3 at 32 bins)
 };
 
 }  // namespace skyfarm
