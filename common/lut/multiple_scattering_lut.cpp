@@ -15,6 +15,14 @@ namespace skyfarm {
 
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
+
+// acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
+// look-up with its weights given (lut::BilinearF::weighted_add).
+inline void weighted_add4(std::size_t B, const float* v00, const float* v01, const float* v10, const float* v11,
+                          float w00, float w01, float w10, float w11, const float* weight, float* __restrict acc) {
+  for (std::size_t b = 0; b < B; ++b)
+    acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
+}
 }  // namespace
 
 SKYFARM_LUT_SIMD_CLONES
@@ -47,7 +55,8 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   std::vector<char> hits(D);
   const std::size_t M = static_cast<std::size_t>(mu_s_samples);
   std::vector<double> mu_s(M), sin_s(M), u_T(M);
-  std::vector<float> L_all(M * B);
+  std::vector<float> L_all(M * B), w00(M), w01(M), w10(M), w11(M);
+  std::vector<int> node(M);
   for (std::size_t col = 0; col < M; ++col) {
     mu_s[col] = -1.0 + 2.0 * static_cast<double>(col) / static_cast<double>(M - 1);
     sin_s[col] = std::sqrt(std::max(0.0, 1.0 - mu_s[col] * mu_s[col]));
@@ -98,15 +107,32 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
     // Single scattering towards x from every sample, for every sun (column)
     // at once: the samples outside, so that the two transmittance rows of a
     // sample's radius stay in cache while all columns read them.
+    // Every column's node and bilinear weights come from one vectorisable
+    // pass per sample (TransmittanceLut::bilinear per look-up costs as much
+    // as the look-up's sum at 32 bins).
     std::fill(L_all.begin(), L_all.end(), 0.0f);
+    const std::size_t stride = transmittance.radius_stride();
+    const int last_node = transmittance.mu_samples() - 2;
     for (std::size_t q = 0; q < D * S; ++q) {
+      const float fj = static_cast<float>(rc[q].fj), gj = 1.0f - fj;
       for (std::size_t col = 0; col < M; ++col) {
         const double mu_q = std::min(1.0, std::max(-1.0, a[q] * sin_s[col] + bcoef[q] * mu_s[col]));
         u_T[col] = transmittance.mu_position(rc[q], mu_q);
+        const int i = std::min(static_cast<int>(std::max(u_T[col], 0.0)), last_node);  // node_of
+        const float f = static_cast<float>(u_T[col] - i);
+        node[col] = i;
+        w00[col] = gj * (1.0f - f);
+        w01[col] = gj * f;
+        w10[col] = fj * (1.0f - f);
+        w11[col] = fj * f;
       }
+      const float* Wq = W.data() + q * B;
       for (std::size_t col = 0; col < M; ++col)
-        if (u_T[col] >= 0.0)
-          transmittance.bilinear(rc[q], u_T[col]).weighted_add(m.bins_, W.data() + q * B, L_all.data() + col * B);
+        if (u_T[col] >= 0.0) {
+          const float* v = transmittance.node_values(rc[q], static_cast<std::size_t>(node[col]));
+          weighted_add4(B, v, v + B, v + stride, v + stride + B, w00[col], w01[col], w10[col], w11[col], Wq,
+                        L_all.data() + col * B);
+        }
     }
     for (std::size_t col = 0; col < M; ++col) {
       std::copy(L_all.begin() + static_cast<std::ptrdiff_t>(col * B),

@@ -97,6 +97,10 @@ ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceL
   u_T_.resize(kViewTile);
   u_ms_.resize(kViewTile);
   phase_f_.resize(kViewTile * C * B);
+  node_T_.resize(kViewTile);
+  node_ms_.resize(kViewTile);
+  frac_T_.resize(kViewTile);
+  frac_ms_.resize(kViewTile);
   L_f_.resize(kViewTile * B);
   // At most kViewTile rows in each (add_step builds rows only then).
   rows_T_.resize(kViewTile * B);
@@ -206,33 +210,45 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
   if (ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer: one fused pass per view
     const float* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
     const float c1 = C == 2 ? 1.0f : 0.0f;
-    // The nodes the views fall on: when they are fewer than the views,
-    // interpolate the tables to this step's radius once (radius_rows).
-    std::size_t t_lo = SIZE_MAX, t_hi = 0, m_lo = SIZE_MAX, m_hi = 0;
+    // Each view's nodes and fractions in both tables, in one vectorisable
+    // pass (u_T < 0: node 0, unused), and the range of nodes the views fall
+    // on: when they are fewer than the views, interpolate the tables to this
+    // step's radius once (radius_rows) and each view along mu only.
+    int *__restrict jt = node_T_.data(), *__restrict jm = node_ms_.data();
+    float *__restrict ft = frac_T_.data(), *__restrict fm = frac_ms_.data();
+    const int t_last = transmittance_.mu_samples() - 2, m_last = ms_->mu_s_samples() - 2;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int t = std::min(static_cast<int>(std::max(u_T[i], 0.0)), t_last);  // TransmittanceLut::node_of
+      const int m = std::min(static_cast<int>(u_ms[i]), m_last);
+      jt[i] = t;
+      jm[i] = m;
+      ft[i] = static_cast<float>(u_T[i] - t);
+      fm[i] = static_cast<float>(u_ms[i] - m);
+    }
+    int t_lo = t_last + 1, t_hi = -1, m_lo = m_last + 1, m_hi = -1;
     for (std::size_t i = 0; i < n; ++i) {
       if (u_T[i] >= 0.0) {
-        t_lo = std::min(t_lo, transmittance_.node_of(u_T[i]));
-        t_hi = std::max(t_hi, transmittance_.node_of(u_T[i]));
+        t_lo = std::min(t_lo, jt[i]);
+        t_hi = std::max(t_hi, jt[i]);
       }
-      m_lo = std::min(m_lo, ms_->node_of(u_ms[i]));
-      m_hi = std::max(m_hi, ms_->node_of(u_ms[i]));
+      m_lo = std::min(m_lo, jm[i]);
+      m_hi = std::max(m_hi, jm[i]);
     }
-    const std::size_t t_rows = t_lo <= t_hi ? t_hi - t_lo + 2 : 0, m_rows = m_hi - m_lo + 2;
+    const std::size_t t_rows = t_lo <= t_hi ? static_cast<std::size_t>(t_hi - t_lo + 2) : 0;
+    const std::size_t m_rows = static_cast<std::size_t>(m_hi - m_lo + 2);
     if (t_rows + m_rows <= n) {
       float *T_rows = rows_T_.data(), *M_rows = rows_M_.data();
-      if (t_rows > 0) transmittance_.radius_rows(rc, t_lo, t_rows, T_rows);
-      ms_->altitude_rows(ms_altitude_[k], m_lo, m_rows, M_rows);
+      if (t_rows > 0) transmittance_.radius_rows(rc, static_cast<std::size_t>(t_lo), t_rows, T_rows);
+      ms_->altitude_rows(ms_altitude_[k], static_cast<std::size_t>(m_lo), m_rows, M_rows);
+      const std::size_t p1 = C == 2 ? B : 0;
       for (std::size_t i = 0; i < n; ++i) {
-        const std::size_t jm = ms_->node_of(u_ms[i]);
-        const float* M = M_rows + (jm - m_lo) * B;
-        const float fm = static_cast<float>(u_ms[i] - static_cast<double>(jm));
+        const float* M = M_rows + static_cast<std::size_t>(jm[i] - m_lo) * B;
         if (u_T[i] >= 0.0) {
-          const std::size_t jt = transmittance_.node_of(u_T[i]);
           const float* p = phase + i * C * B;
-          add_source_rows(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, T_rows + (jt - t_lo) * B,
-                          static_cast<float>(u_T[i] - static_cast<double>(jt)), M, fm, wms);
+          add_source_rows(B, L + i * B, wc, p, wc1, p + p1, c1, T_rows + static_cast<std::size_t>(jt[i] - t_lo) * B,
+                          ft[i], M, fm[i], wms);
         } else {
-          add_weighted_row(B, L + i * B, M, fm, wms);
+          add_weighted_row(B, L + i * B, M, fm[i], wms);
         }
       }
       return;

@@ -89,7 +89,8 @@ class ScatteringMarch {
   std::vector<double> s_t_, s_s_, s_c_;  // scratch per step
   // Scratch of the look-ups (a ScatteringMarch is used by one thread at a time).
   mutable std::vector<double> tmp_, u_T_, u_ms_, mu0_;
-  mutable std::vector<float> w_phase_, phase_f_, L_f_, rows_T_, rows_M_;
+  mutable std::vector<float> w_phase_, phase_f_, L_f_, rows_T_, rows_M_, frac_T_, frac_ms_;
+  mutable std::vector<int> node_T_, node_ms_;
 };
 
 }  // namespace skyfarm

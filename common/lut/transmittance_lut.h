@@ -92,6 +92,12 @@ class TransmittanceLut {
     const float f = static_cast<float>(rc.fj), g = 1.0f - f;
     for (std::size_t k = 0; k < n; ++k) out[k] = g * a[k] + f * b[k];
   }
+  // For loops that build their own bilinear weights: the values at rc's
+  // row and mu node i, and the distance (in values) to the next row.
+  const float* node_values(const RadiusCoord& rc, std::size_t i) const {
+    return values_.data() + rc.row + i * static_cast<std::size_t>(bins_);
+  }
+  std::size_t radius_stride() const { return static_cast<std::size_t>(n_mu_) * static_cast<std::size_t>(bins_); }
   // The node i (u in [i, i + 1]) that bilinear() interpolates from, u >= 0.
   std::size_t node_of(double u) const {
     return std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_ - 2));
