@@ -167,10 +167,10 @@ void MediumTable::build_coefficients(const Atmosphere& atmosphere, const Spectra
   terms_ = static_cast<int>(terms.profiles.size());
   padded_terms_ = std::max(8, (terms_ + 7) / 8 * 8);
   const std::size_t K = static_cast<std::size_t>(padded_terms_);
-  term_profiles_.assign(H * K, 0.0);
+  term_profiles_.assign(H * K / 8, EightTerms{});
   term_spectra_.assign(K * B, 0.0);
   for (std::size_t k = 0; k < terms.profiles.size(); ++k) {
-    for (std::size_t i = 0; i < H; ++i) term_profiles_[i * K + k] = terms.profiles[k][i];
+    for (std::size_t i = 0; i < H; ++i) term_profiles_[i * K / 8 + k / 8].value[k % 8] = terms.profiles[k][i];
     std::copy(terms.spectra[k].begin(), terms.spectra[k].end(), term_spectra_.begin() + static_cast<std::ptrdiff_t>(k * B));
   }
 }
@@ -205,7 +205,7 @@ void MediumTable::phase_exact(double nu, double* out) const {
 
 std::size_t MediumTable::memory_bytes() const {
   return sizeof(double) * (sigma_t_.size() + sigma_s_.size() + sigma_s_c_.size() + phase_table_.size() +
-                            albedo_.size() + term_profiles_.size() + term_spectra_.size()) +
+                            albedo_.size() + 8 * term_profiles_.size() + term_spectra_.size()) +
          sizeof(PhaseFunction) * phase_functions_.size();
 }
 

@@ -85,11 +85,18 @@ class MediumTable {
   void phase_exact(double nu, double* out) const;
 
   // The extinction terms (above): term_count() real ones, padded_terms()
-  // stored per node (a multiple of 8, zero beyond term_count()).
+  // stored per node (a multiple of 8, zero beyond term_count()), in blocks of
+  // eight on a 64-byte line each (the quadrature loads a block as one vector).
+  struct alignas(64) EightTerms {
+    double value[8];
+  };
   int term_count() const { return terms_; }
   int padded_terms() const { return padded_terms_; }
-  const double* term_profiles() const { return term_profiles_.data(); }  // [node][k]
-  const double* term_spectra() const { return term_spectra_.data(); }    // [k][bin]
+  // Terms k0 .. k0 + 7 of node i's profile values (k0 a multiple of 8).
+  const double* term_block(std::size_t i, std::size_t k0) const {
+    return term_profiles_[i * static_cast<std::size_t>(padded_terms_ / 8) + k0 / 8].value;
+  }
+  const double* term_spectra() const { return term_spectra_.data(); }  // [k][bin]
 
   const std::vector<double>& ground_albedo() const { return albedo_; }
   std::size_t memory_bytes() const;
@@ -110,7 +117,8 @@ class MediumTable {
   std::vector<PhaseFunction> phase_functions_;         // [c][bin]
   std::vector<double> phase_table_;                    // [x node][c][bin]
   std::vector<double> albedo_;                         // [bin]
-  std::vector<double> term_profiles_, term_spectra_;   // [node][padded k], [padded k][bin]
+  std::vector<EightTerms> term_profiles_;              // [node][padded k / 8]
+  std::vector<double> term_spectra_;                   // [padded k][bin]
 };
 
 }  // namespace skyfarm

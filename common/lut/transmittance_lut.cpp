@@ -41,23 +41,22 @@ class OpticalDepthQuadrature {
 
   // terms[k] = int rho_k ds from radius r along mu to the top (rays into the
   // ground as if the planet were absent), k < medium.padded_terms().
-  void terms_to_top(double r, double mu, double* terms) {
+  [[gnu::always_inline]] void terms_to_top(double r, double mu, double* terms) {
     const double R = medium_.planet_radius_m(), R_top = medium_.top_radius_m();
     std::fill(terms, terms + medium_.padded_terms(), 0.0);
     r = std::clamp(r, R, R_top);
     const double l = r * std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
     const double s0 = r * mu;
     const double s_top = std::sqrt(std::max(0.0, (R_top - l) * (R_top + l)));
-    if (s0 < 0.0) {  // descends to the closest approach first: two ascending parts in |s|
-      add_part(l, 0.0, -s0, terms);
-      add_part(l, 0.0, s_top, terms);
-    } else {
-      add_part(l, s0, s_top, terms);
-    }
+    // A ray that descends to the closest approach first has two ascending
+    // parts in |s|.  (One call site in a loop: with a = 0 as a constant, GCC
+    // specialises add_part and leaves that copy's loop scalar.)
+    const double from[2] = {std::max(s0, 0.0), 0.0}, to[2] = {s0 < 0.0 ? -s0 : s_top, s_top};
+    for (int part = 0; part < (s0 < 0.0 ? 2 : 1); ++part) add_part(l, from[part], to[part], terms);
   }
 
   // tau[b] from the terms.
-  void expand(const double* terms, double* tau) const {
+  [[gnu::always_inline]] void expand(const double* terms, double* tau) const {
     const std::size_t B = static_cast<std::size_t>(medium_.bins());
     const double* spectra = medium_.term_spectra();
     std::fill(tau, tau + B, 0.0);
@@ -72,7 +71,7 @@ class OpticalDepthQuadrature {
   // One part at distances [a, b] past the closest approach (radius l): the
   // samples' altitude nodes and weights in one vectorisable pass, then the
   // terms' profiles interpolated and summed.
-  void add_part(double l, double a, double b, double* terms) {
+  [[gnu::always_inline]] void add_part(double l, double a, double b, double* terms) {
     if (!(b > a)) return;
     const double R = medium_.planet_radius_m(), inv_dh = 1.0 / medium_.altitude_step_m();
     const double top_node = medium_.altitude_samples() - 1;
@@ -97,13 +96,12 @@ class OpticalDepthQuadrature {
     // Eight terms at a time, in a local accumulator that stays in registers
     // (through memory, every sample would wait for the previous store).
     const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
-    const double* profiles = medium_.term_profiles();
     for (std::size_t c = 0; c < K; c += 8) {
       double acc[8];
       for (std::size_t j = 0; j < 8; ++j) acc[j] = terms[c + j];
       for (std::size_t k = 0; k < n; ++k) {
-        const double* p0 = profiles + static_cast<std::size_t>(node[k]) * K + c;
-        const double* p1 = p0 + K;
+        const double* p0 = medium_.term_block(static_cast<std::size_t>(node[k]), c);
+        const double* p1 = medium_.term_block(static_cast<std::size_t>(node[k]) + 1, c);
         const double a0 = w0[k], a1 = w1[k];
         for (std::size_t j = 0; j < 8; ++j) acc[j] += a0 * p0[j] + a1 * p1[j];
       }
