@@ -18,6 +18,15 @@
 // x_t . s = r_0 mu_s0 + t nu, so the sun's zenith cosine at x_t is
 //   mu_s(t) = (r_0 mu_s0 + t nu) / r_t,
 // which depends on the sun only through mu_s0 (at x_0) and nu.
+//
+// Precision and speed: geometry, positions in the tables and T(x_0, x_k)
+// are double; the per-step weights, the phase values and the sums over a
+// call's steps are single precision, like the transmittance and multiple-
+// scattering tables (bilinear.h), and are added to the caller's doubles once
+// per call.  Views go in tiles of 32 (their data stay in the L1 cache), and
+// when a tile's views fall on fewer table nodes than there are views, both
+// tables are interpolated to the step's radius once and each view along
+// mu_s only (add_step).
 #pragma once
 #include <span>
 #include <vector>

@@ -24,7 +24,8 @@
 // power (measured on the Earth preset, 256 x 128 nodes, worst error relative
 // to the test's tolerance max(0.5 % T, 1e-4): 0.50 with this warp, 0.56 with
 // a cube root, 1.2 with a square root, 25 without).  Values are stored at the nodes
-// (v = k / (n - 1), x_r = j / (n - 1)) and interpolated bilinearly.  Rays below the horizon get T = 0 (the planet
+// (v = k / (n - 1), x_r = j / (n - 1)), in single precision (bilinear.h), and
+// interpolated bilinearly.  Rays below the horizon get T = 0 (the planet
 // hides the sun; a hard shadow: the disk's penumbra is not modelled).
 //
 // Quadrature: along the ray's line, s is the distance past the closest
