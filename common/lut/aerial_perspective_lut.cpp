@@ -27,8 +27,8 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
   a.mapping_ = lut::ViewMapping(r, R, zenith_rows, azimuth_columns);
   const std::size_t B = static_cast<std::size_t>(a.bins_), cols = static_cast<std::size_t>(azimuth_columns);
   const std::size_t rows = static_cast<std::size_t>(a.mapping_.rows()), N = static_cast<std::size_t>(slices);
-  a.L_.assign(N * rows * cols * B, 0.0);
-  a.T_.assign(N * rows * B, 0.0);
+  a.L_.assign(N * rows * cols * B, 0.0f);
+  a.T_.assign(N * rows * B, 0.0f);
   a.end_.assign(rows, 0.0);
   const double sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
 
@@ -46,7 +46,7 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
     march.prepare_boundaries(r, mu, boundaries, false);
     for (std::size_t k = 0; k < N; ++k)
       std::copy(march.T_before(static_cast<int>(k)), march.T_before(static_cast<int>(k)) + B,
-                a.T_.begin() + static_cast<std::ptrdiff_t>((row * N + k) * B));
+                a.T_.begin() + static_cast<std::ptrdiff_t>((row * N + k) * B));  // (to float)
     for (std::size_t col = 0; col < cols; ++col) {
       nu[col] = mu * mu_s + sin_theta * sin_s * a.mapping_.cos_phi_of_column(static_cast<int>(col));
       medium.phase(nu[col], phase.data() + col * CB);
@@ -56,8 +56,8 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
       march.add_inscattering(static_cast<int>(cols), nu.data(), phase.data(), mu_s, static_cast<int>(k - 1),
                              static_cast<int>(k), L.data());
       for (std::size_t col = 0; col < cols; ++col) {
-        double* out = a.L_.data() + ((row * cols + col) * N + k) * B;
-        for (std::size_t b = 0; b < B; ++b) out[b] = L[col * B + b] * sun_irradiance[b];
+        float* out = a.L_.data() + ((row * cols + col) * N + k) * B;
+        for (std::size_t b = 0; b < B; ++b) out[b] = static_cast<float>(L[col * B + b] * sun_irradiance[b]);
       }
     }
   }
@@ -81,11 +81,11 @@ void AerialPerspectiveLut::lookup(double mu, double cos_phi, double distance_m, 
   for (std::size_t i = 0; i < 2; ++i) {
     const std::size_t row = p.row + i;
     const double w_row = i == 0 ? 1.0 - p.f_row : p.f_row;
-    const double* t = T_.data() + (row * N + k) * B;
+    const float* t = T_.data() + (row * N + k) * B;
     for (std::size_t b = 0; b < B; ++b) T[b] += w_row * ((1.0 - f) * t[b] + f * t[B + b]);
     for (std::size_t j = 0; j < 2; ++j) {
       const double w = w_row * (j == 0 ? 1.0 - p.f_column : p.f_column);
-      const double* l = L_.data() + ((row * cols + p.column + j) * N + k) * B;
+      const float* l = L_.data() + ((row * cols + p.column + j) * N + k) * B;
       for (std::size_t b = 0; b < B; ++b) L_in[b] += w * ((1.0 - f) * l[b] + f * l[B + b]);
     }
   }

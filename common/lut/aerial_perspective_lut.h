@@ -51,15 +51,15 @@ class AerialPerspectiveLut {
 
   double max_distance_m() const { return d_max_; }
   const lut::ViewMapping& mapping() const { return mapping_; }
-  std::size_t memory_bytes() const { return (L_.size() + T_.size()) * sizeof(double); }
+  std::size_t memory_bytes() const { return (L_.size() + T_.size()) * sizeof(float); }
 
  private:
   int bins_ = 0, slices_ = 0;
   double d_max_ = 0.0, R_top_ = 0.0;
   lut::ViewMapping mapping_;
   std::vector<double> end_;  // [row]: the distance of the last slice
-  std::vector<double> L_;    // [row][column][slice][bin]
-  std::vector<double> T_;    // [row][slice][bin]
+  std::vector<float> L_;     // [row][column][slice][bin], single precision (as the sky view)
+  std::vector<float> T_;     // [row][slice][bin]
 };
 
 }  // namespace skyfarm

@@ -24,17 +24,18 @@ GroundIrradianceLut GroundIrradianceLut::build(const MediumTable& medium, const 
   g.values_.assign(static_cast<std::size_t>(mu_s_samples) * B, 0.0);
   const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
   ScatteringMarch march(medium, transmittance, &multiple_scattering, nullptr);
-  std::vector<double> phase(static_cast<std::size_t>(medium.scatterers()) * B);
+  const std::size_t M = static_cast<std::size_t>(mu_s_samples), CB = static_cast<std::size_t>(medium.scatterers()) * B;
+  std::vector<double> mu_s(M), nu(M), phase(M * CB);
+  for (std::size_t k = 0; k < M; ++k) mu_s[k] = -1.0 + 2.0 * static_cast<double>(k) / static_cast<double>(M - 1);
   for (const glm::dvec3& w : lut::fibonacci_cosine_hemisphere(directions)) {
-    // From the ground, upwards: the ray never meets the ground again.
+    // From the ground, upwards: the ray never meets the ground again.  Every
+    // sun (node) is a view of the same march.
     march.prepare(R, w.z, lut::distance_to_top(R, w.z, R_top), false, steps);
-    for (int k = 0; k < mu_s_samples; ++k) {
-      const double mu_s = -1.0 + 2.0 * k / (mu_s_samples - 1);
-      const double nu = w.x * std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s)) + w.z * mu_s;  // s = (sin, 0, mu_s)
-      medium.phase(nu, phase.data());
-      march.add_inscattering(phase.data(), nu, mu_s, 0, march.steps(),
-                             g.values_.data() + static_cast<std::size_t>(k) * B);
+    for (std::size_t k = 0; k < M; ++k) {
+      nu[k] = w.x * std::sqrt(std::max(0.0, 1.0 - mu_s[k] * mu_s[k])) + w.z * mu_s[k];  // s = (sin, 0, mu_s)
+      medium.phase(nu[k], phase.data() + k * CB);
     }
+    march.add_inscattering(mu_s_samples, nu.data(), mu_s.data(), phase.data(), 0, march.steps(), g.values_.data());
   }
   for (double& v : g.values_) v *= kPi / directions;
   return g;

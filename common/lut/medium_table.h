@@ -28,7 +28,18 @@
 //
 // Layout: row-major [node][bin] (and [node][c][bin]) so that all bins of one
 // altitude are contiguous and the per-bin loops vectorise.
+//
+// Extinction terms: sigma_t(h, b) = sum_k rho_k(h) kappa_k[b], exactly (to
+// rounding), because every constituent's coefficients are its density times
+// a spectrum (constituent.h), except ozone's, whose cross-section is linear
+// between temperature columns (ozone.h temperature_bracket): each column is
+// one term, with the density times the column's weight at that altitude as
+// its profile.  The Earth preset has 7 terms (air, aerosols, 5 ozone
+// columns) for any number of bins; the transmittance quadrature sums the
+// profiles along a ray and expands to the bins once (transmittance_lut.cpp).
+// Profiles are stored [node][k], padded with zero terms to a multiple of 8.
 #pragma once
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -54,18 +65,17 @@ class MediumTable {
     std::size_t i;
     double f;
   };
-  Node locate(double altitude_m) const;
+  Node locate(double altitude_m) const {
+    const double u = std::clamp(altitude_m * inv_dh_, 0.0, static_cast<double>(altitude_samples_ - 1));
+    const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(altitude_samples_ - 2));
+    return {i, u - static_cast<double>(i)};
+  }
+  int altitude_samples() const { return altitude_samples_; }
+  double altitude_step_m() const { return dh_; }
 
   // Interpolated coefficients at a located altitude, out[b] for b < bins.
   void sigma_t(Node n, double* out) const { interpolate(sigma_t_, n, bins_, out); }
   void sigma_s(Node n, double* out) const { interpolate(sigma_s_, n, bins_, out); }
-  // acc[b] += weight * sigma_t[b] (the transmittance quadrature).
-  void add_sigma_t(Node n, double weight, double* acc) const {
-    const double* a = sigma_t_.data() + n.i * static_cast<std::size_t>(bins_);
-    const double* b = a + bins_;
-    const double w0 = weight * (1.0 - n.f), w1 = weight * n.f;
-    for (int k = 0; k < bins_; ++k) acc[k] += w0 * a[k] + w1 * b[k];
-  }
   // All scatterers at once: out[c * bins + b].
   void sigma_s_per_scatterer(Node n, double* out) const { interpolate(sigma_s_c_, n, scatterers_ * bins_, out); }
 
@@ -73,6 +83,20 @@ class MediumTable {
   void phase(double nu, double* out) const;
   // The same, evaluated exactly (the reference march).
   void phase_exact(double nu, double* out) const;
+
+  // The extinction terms (above): term_count() real ones, padded_terms()
+  // stored per node (a multiple of 8, zero beyond term_count()), in blocks of
+  // eight on a 64-byte line each (the quadrature loads a block as one vector).
+  struct alignas(64) EightTerms {
+    double value[8];
+  };
+  int term_count() const { return terms_; }
+  int padded_terms() const { return padded_terms_; }
+  // Terms k0 .. k0 + 7 of node i's profile values (k0 a multiple of 8).
+  const double* term_block(std::size_t i, std::size_t k0) const {
+    return term_profiles_[i * static_cast<std::size_t>(padded_terms_ / 8) + k0 / 8].value;
+  }
+  const double* term_spectra() const { return term_spectra_.data(); }  // [k][bin]
 
   const std::vector<double>& ground_albedo() const { return albedo_; }
   std::size_t memory_bytes() const;
@@ -84,12 +108,17 @@ class MediumTable {
     for (int k = 0; k < width; ++k) out[k] = a[k] + n.f * (b[k] - a[k]);
   }
 
-  int bins_ = 0, scatterers_ = 0, altitude_samples_ = 0, phase_samples_ = 0;
+  void build_coefficients(const Atmosphere& atmosphere, const SpectralGrid& grid);
+  void build_phase(const Atmosphere& atmosphere, const SpectralGrid& grid);
+
+  int bins_ = 0, scatterers_ = 0, altitude_samples_ = 0, phase_samples_ = 0, terms_ = 0, padded_terms_ = 0;
   double R_ = 0.0, R_top_ = 0.0, dh_ = 0.0, inv_dh_ = 0.0;
   std::vector<double> sigma_t_, sigma_s_, sigma_s_c_;  // [node][bin], [node][c][bin]
   std::vector<PhaseFunction> phase_functions_;         // [c][bin]
   std::vector<double> phase_table_;                    // [x node][c][bin]
   std::vector<double> albedo_;                         // [bin]
+  std::vector<EightTerms> term_profiles_;              // [node][padded k / 8]
+  std::vector<double> term_spectra_;                   // [padded k][bin]
 };
 
 }  // namespace skyfarm

@@ -15,6 +15,14 @@ namespace skyfarm {
 
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
+
+// acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
+// look-up with its weights given (lut::BilinearF::weighted_add).
+inline void weighted_add4(std::size_t B, const float* v00, const float* v01, const float* v10, const float* v11,
+                          float w00, float w01, float w10, float w11, const float* weight, float* __restrict acc) {
+  for (std::size_t b = 0; b < B; ++b)
+    acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
+}
 }  // namespace
 
 SKYFARM_LUT_SIMD_CLONES
@@ -31,7 +39,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   const std::size_t B = static_cast<std::size_t>(m.bins_), S = static_cast<std::size_t>(steps);
   const std::size_t D = static_cast<std::size_t>(directions);
   const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
-  m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0);
+  m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0f);
   const std::vector<glm::dvec3> dirs = lut::fibonacci_sphere(directions);
   const std::vector<double>& albedo = medium.ground_albedo();
   const TransmittanceLut::RadiusCoord ground_rc = transmittance.locate_r(R);
@@ -39,10 +47,20 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   // Per altitude row, everything that does not depend on the sun: the
   // weights T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of every step,
   // the step's T-LUT radius, and mu_s at the step as a sin_s + b mu_s.
-  std::vector<double> W(D * S * B), T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
+  // (W and the sums over the samples in single precision, as the tables: bilinear.h.)
+  std::vector<float> W(D * S * B);
+  std::vector<double> T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
   std::vector<TransmittanceLut::RadiusCoord> rc(D * S);
   std::vector<double> a(D * S), bcoef(D * S), a_g(D), b_g(D), t_mid(S), dt(S);
   std::vector<char> hits(D);
+  const std::size_t M = static_cast<std::size_t>(mu_s_samples);
+  std::vector<double> mu_s(M), sin_s(M), u_T(M);
+  std::vector<float> L_all(M * B), w00(M), w01(M), w10(M), w11(M);
+  std::vector<int> node(M);
+  for (std::size_t col = 0; col < M; ++col) {
+    mu_s[col] = -1.0 + 2.0 * static_cast<double>(col) / static_cast<double>(M - 1);
+    sin_s[col] = std::sqrt(std::max(0.0, 1.0 - mu_s[col] * mu_s[col]));
+  }
   for (int j = 0; j < altitude_samples; ++j) {
     const double r = R + m.top_altitude_ * j / (altitude_samples - 1);
     std::fill(f_ms.begin(), f_ms.end(), 0.0);
@@ -58,12 +76,13 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         const MediumTable::Node node = medium.locate(rk - R);
         medium.sigma_t(node, s_t.data());
         medium.sigma_s(node, s_s.data());
-        double* Wk = W.data() + (i * S + k) * B;
+        float* Wk = W.data() + (i * S + k) * B;
         for (std::size_t b = 0; b < B; ++b) {
           double integral;
           const double T_seg = lut::T_and_in_scattering_integral(s_t[b], dt[k], &integral);
-          Wk[b] = T_acc[b] * integral * s_s[b];
-          f_ms[b] += Wk[b];
+          const double w = T_acc[b] * integral * s_s[b];
+          Wk[b] = static_cast<float>(w);
+          f_ms[b] += w;
           T_acc[b] *= T_seg;
         }
         rc[i * S + k] = transmittance.locate_r(rk);
@@ -85,26 +104,51 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         ++m.clamped_;
       }
     }
-    for (int col = 0; col < mu_s_samples; ++col) {
-      const double mu_s = -1.0 + 2.0 * col / (mu_s_samples - 1), sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
-      std::fill(L.begin(), L.end(), 0.0);
-      for (std::size_t q = 0; q < D * S; ++q) {
-        const double mu_q = std::clamp(a[q] * sin_s + bcoef[q] * mu_s, -1.0, 1.0);
-        const double u = transmittance.mu_position(rc[q], mu_q);
-        if (u >= 0.0) transmittance.bilinear(rc[q], u).weighted_add(m.bins_, W.data() + q * B, L.data());
+    // Single scattering towards x from every sample, for every sun (column)
+    // at once: the samples outside, so that the two transmittance rows of a
+    // sample's radius stay in cache while all columns read them.
+    // Every column's node and bilinear weights come from one vectorisable
+    // pass per sample (TransmittanceLut::bilinear per look-up costs as much
+    // as the look-up's sum at 32 bins).
+    std::fill(L_all.begin(), L_all.end(), 0.0f);
+    const std::size_t stride = transmittance.radius_stride();
+    const int last_node = transmittance.mu_samples() - 2;
+    for (std::size_t q = 0; q < D * S; ++q) {
+      const float fj = static_cast<float>(rc[q].fj), gj = 1.0f - fj;
+      for (std::size_t col = 0; col < M; ++col) {
+        const double mu_q = std::min(1.0, std::max(-1.0, a[q] * sin_s[col] + bcoef[q] * mu_s[col]));
+        u_T[col] = transmittance.mu_position(rc[q], mu_q);
+        const int i = std::min(static_cast<int>(std::max(u_T[col], 0.0)), last_node);  // node_of
+        const float f = static_cast<float>(u_T[col] - i);
+        node[col] = i;
+        w00[col] = gj * (1.0f - f);
+        w01[col] = gj * f;
+        w10[col] = fj * (1.0f - f);
+        w11[col] = fj * f;
       }
+      const float* Wq = W.data() + q * B;
+      for (std::size_t col = 0; col < M; ++col)
+        if (u_T[col] >= 0.0) {
+          const float* v = transmittance.node_values(rc[q], static_cast<std::size_t>(node[col]));
+          weighted_add4(B, v, v + B, v + stride, v + stride + B, w00[col], w01[col], w10[col], w11[col], Wq,
+                        L_all.data() + col * B);
+        }
+    }
+    for (std::size_t col = 0; col < M; ++col) {
+      std::copy(L_all.begin() + static_cast<std::ptrdiff_t>(col * B),
+                L_all.begin() + static_cast<std::ptrdiff_t>((col + 1) * B), L.begin());
       for (std::size_t b = 0; b < B; ++b) L[b] *= kInv4Pi;  // the sun's phase p_u
       // The ground's Lambertian reflection of the attenuated sun (Hillaire's code,
       // IntegrateScatteredLuminance "bounced light off the earth").
       for (std::size_t i = 0; i < D; ++i) {
         if (!hits[i]) continue;
-        const double mu_g = std::clamp(a_g[i] * sin_s + b_g[i] * mu_s, -1.0, 1.0);
+        const double mu_g = std::clamp(a_g[i] * sin_s[col] + b_g[i] * mu_s[col], -1.0, 1.0);
         if (mu_g <= 0.0) continue;
         transmittance.lookup(ground_rc, transmittance.mu_position(ground_rc, mu_g), T_sun.data());
         for (std::size_t b = 0; b < B; ++b) L[b] += T_ground[i * B + b] * T_sun[b] * mu_g * albedo[b] * kInvPi;
       }
-      double* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
-      for (std::size_t b = 0; b < B; ++b) out[b] = (L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]);
+      float* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
+      for (std::size_t b = 0; b < B; ++b) out[b] = static_cast<float>((L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]));
     }
   }
   return m;

@@ -44,18 +44,30 @@ class MultipleScatteringLut {
   // Where (h, mu_s) falls: the altitude part (reused along a march step)
   // and the fractional node position along mu_s.
   struct AltitudeCoord {
-    std::size_t row;  // offset of node (j, 0), in doubles
+    std::size_t row;  // offset of node (j, 0), in values
     double fj;        // weight of row j + 1
   };
   AltitudeCoord locate_altitude(double altitude_m) const;
   double mu_s_position(double mu_s) const { return std::clamp(0.5 * (mu_s + 1.0), 0.0, 1.0) * (n_mu_s_ - 1); }
   int mu_s_samples() const { return n_mu_s_; }
   // The four nodes and weights around (a, u), for fused loops.
-  lut::Bilinear bilinear(const AltitudeCoord& a, double u) const {
+  lut::BilinearF bilinear(const AltitudeCoord& a, double u) const {
     const std::size_t k = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_s_ - 2));
     const std::size_t B = static_cast<std::size_t>(bins_);
-    return lut::Bilinear(values_.data() + a.row + k * B, static_cast<std::size_t>(n_mu_s_) * B, B, a.fj,
-                         u - static_cast<double>(k));
+    return lut::BilinearF(values_.data() + a.row + k * B, static_cast<std::size_t>(n_mu_s_) * B, B, a.fj,
+                          u - static_cast<double>(k));
+  }
+  // The altitude half of that interpolation for the mu_s nodes [first,
+  // first + count): out[m * bins + b] (TransmittanceLut::radius_rows).
+  void altitude_rows(const AltitudeCoord& a, std::size_t first, std::size_t count, float* __restrict out) const {
+    const std::size_t B = static_cast<std::size_t>(bins_), n = count * B;
+    const float* __restrict v0 = values_.data() + a.row + first * B;
+    const float* __restrict v1 = v0 + static_cast<std::size_t>(n_mu_s_) * B;
+    const float f = static_cast<float>(a.fj), g = 1.0f - f;
+    for (std::size_t k = 0; k < n; ++k) out[k] = g * v0[k] + f * v1[k];
+  }
+  std::size_t node_of(double u) const {
+    return std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_s_ - 2));
   }
   // Psi_ms per bin (bilinear).
   void lookup(const AltitudeCoord& a, double u, double* out) const;
@@ -66,12 +78,12 @@ class MultipleScatteringLut {
   }
 
   int clamped_nodes() const { return clamped_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(double); }
+  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
   int bins_ = 0, n_mu_s_ = 0, n_h_ = 0, clamped_ = 0;
   double top_altitude_ = 0.0;
-  std::vector<double> values_;  // [altitude node][mu_s node][bin]
+  std::vector<float> values_;  // [altitude node][mu_s node][bin], single precision (bilinear.h)
 };
 
 }  // namespace skyfarm

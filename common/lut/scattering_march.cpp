@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "common/core/constants.h"
 #include "common/lut/ground_irradiance_lut.h"
@@ -12,23 +13,68 @@ namespace skyfarm {
 
 namespace {
 
+// Views per tile in add_inscattering.
+constexpr std::size_t kViewTile = 32;
+
+// The sums over the steps are in single precision, like the tables they
+// read (bilinear.h): a step's weights, the views' phase values and their
+// partial sums are floats, added to the caller's doubles once per call.
+
 // L[b] += (w0 p0 + c1 w1 p1)[b] T_sun[b] + w_ms[b] Psi[b], T_sun and Psi
 // bilinear from their tables: the sky-view build's innermost loop, one pass
 // over the bins.  (__restrict: L never overlaps the tables or weights;
 // without it the loop needs more run-time alias checks than GCC emits, and
 // stays scalar.)
-inline void add_source(std::size_t B, double* __restrict L, const double* w0, const double* p0, const double* w1,
-                       const double* p1, double c1, const lut::Bilinear& t, const double* w_ms,
-                       const lut::Bilinear& m) {
-  const double *t00 = t.v00, *t01 = t.v01, *t10 = t.v10, *t11 = t.v11;
-  const double *m00 = m.v00, *m01 = m.v01, *m10 = m.v10, *m11 = m.v11;
-  const double tw00 = t.w00, tw01 = t.w01, tw10 = t.w10, tw11 = t.w11;
-  const double mw00 = m.w00, mw01 = m.w01, mw10 = m.w10, mw11 = m.w11;
+inline void add_source(std::size_t B, float* __restrict L, const float* w0, const float* p0, const float* w1,
+                       const float* p1, float c1, const lut::BilinearF& t, const float* w_ms,
+                       const lut::BilinearF& m) {
+  const float *t00 = t.v00, *t01 = t.v01, *t10 = t.v10, *t11 = t.v11;
+  const float *m00 = m.v00, *m01 = m.v01, *m10 = m.v10, *m11 = m.v11;
+  const float tw00 = static_cast<float>(t.w00), tw01 = static_cast<float>(t.w01), tw10 = static_cast<float>(t.w10),
+              tw11 = static_cast<float>(t.w11);
+  const float mw00 = static_cast<float>(m.w00), mw01 = static_cast<float>(m.w01), mw10 = static_cast<float>(m.w10),
+              mw11 = static_cast<float>(m.w11);
   for (std::size_t b = 0; b < B; ++b) {
-    const double T_sun = tw00 * t00[b] + tw01 * t01[b] + tw10 * t10[b] + tw11 * t11[b];
-    const double psi = mw00 * m00[b] + mw01 * m01[b] + mw10 * m10[b] + mw11 * m11[b];
+    const float T_sun = tw00 * t00[b] + tw01 * t01[b] + tw10 * t10[b] + tw11 * t11[b];
+    const float psi = mw00 * m00[b] + mw01 * m01[b] + mw10 * m10[b] + mw11 * m11[b];
     L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
   }
+}
+
+// The same with T and Psi linear between two of the rows that radius_rows
+// and altitude_rows built for the step: t, t + B and m, m + B.
+inline void add_source_rows(std::size_t B, float* __restrict L, const float* w0, const float* p0, const float* w1,
+                            const float* p1, float c1, const float* t, float ft, const float* m, float fm,
+                            const float* w_ms) {
+  const float gt = 1.0f - ft, gm = 1.0f - fm;
+  for (std::size_t b = 0; b < B; ++b) {
+    const float T_sun = gt * t[b] + ft * t[B + b];
+    const float psi = gm * m[b] + fm * m[B + b];
+    L[b] += (w0[b] * p0[b] + c1 * (w1[b] * p1[b])) * T_sun + w_ms[b] * psi;
+  }
+}
+
+// L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
+// whose point the planet hides from the sun.
+inline void add_weighted_row(std::size_t B, float* __restrict L, const float* m, float f, const float* w) {
+  const float g = 1.0f - f;
+  for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
+}
+
+// One step through a segment, per bin: T1 = T0 T_seg and w = T0 int_seg
+// exp(-sigma_t s) ds.  (Separate restrict-qualified arrays, so that the loop
+// vectorises without run-time alias checks.)
+inline void segment_weights(std::size_t B, const double* __restrict T0, const double* __restrict sigma_t, double dt,
+                            double* __restrict T1, double* __restrict w) {
+  for (std::size_t b = 0; b < B; ++b) {
+    double integral;
+    T1[b] = T0[b] * lut::T_and_in_scattering_integral(sigma_t[b], dt, &integral);
+    w[b] = T0[b] * integral;
+  }
+}
+
+inline void multiply(std::size_t B, const double* __restrict a, const double* __restrict b, float* __restrict out) {
+  for (std::size_t k = 0; k < B; ++k) out[k] = static_cast<float>(a[k] * b[k]);
 }
 
 }  // namespace
@@ -48,6 +94,17 @@ ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceL
   s_c_.resize(C * B);
   w_phase_.resize(B);
   tmp_.resize(B);
+  u_T_.resize(kViewTile);
+  u_ms_.resize(kViewTile);
+  phase_f_.resize(kViewTile * C * B);
+  node_T_.resize(kViewTile);
+  node_ms_.resize(kViewTile);
+  frac_T_.resize(kViewTile);
+  frac_ms_.resize(kViewTile);
+  L_f_.resize(kViewTile * B);
+  // At most kViewTile rows in each (add_step builds rows only then).
+  rows_T_.resize(kViewTile * B);
+  rows_M_.resize(kViewTile * B);
 }
 
 void ScatteringMarch::prepare(double r0, double mu, double t_end, bool ends_on_ground, int steps) {
@@ -74,6 +131,7 @@ void ScatteringMarch::prepare_boundaries(double r0, double mu, std::span<const d
 
 // The sun-independent part: per step the coefficients at the midpoint, the
 // segment's transmittance and in-scattering integral, and the weights.
+SKYFARM_LUT_SIMD_CLONES
 void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t S = static_cast<std::size_t>(steps_);
@@ -99,65 +157,124 @@ void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
     medium_.sigma_t(node, s_t_.data());
     medium_.sigma_s(node, s_s_.data());
     medium_.sigma_s_per_scatterer(node, s_c_.data());
-    const double* T0 = T_before_.data() + k * B;
-    double* T1 = T_before_.data() + (k + 1) * B;
-    double* wms = w_ms_.data() + k * B;
-    double* wc = w_c_.data() + k * C * B;
-    for (std::size_t b = 0; b < B; ++b) {
-      double integral;
-      T1[b] = T0[b] * lut::T_and_in_scattering_integral(s_t_[b], dt_[k], &integral);
-      const double w = T0[b] * integral;
-      wms[b] = w * s_s_[b];
-      for (std::size_t c = 0; c < C; ++c) wc[c * B + b] = w * s_c_[c * B + b];
-    }
+    const double* T0 = T_before(static_cast<int>(k));
+    double* w = tmp_.data();
+    segment_weights(B, T0, s_t_.data(), dt_[k], T_before_.data() + (k + 1) * B, w);
+    multiply(B, w, s_s_.data(), w_ms_.data() + k * B);
+    for (std::size_t c = 0; c < C; ++c) multiply(B, w, s_c_.data() + c * B, w_c_.data() + (k * C + c) * B);
   }
 }
 
-SKYFARM_LUT_SIMD_CLONES
 void ScatteringMarch::add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1,
                                        double* L) const {
+  if (mu0_.size() < static_cast<std::size_t>(std::max(0, n))) mu0_.resize(static_cast<std::size_t>(n));
+  std::fill(mu0_.begin(), mu0_.begin() + std::max(0, n), mu_s0);
+  add_inscattering(n, nu, mu0_.data(), phase, k0, k1, L);
+}
+
+// Views in tiles of kViewTile, all steps per tile: a tile's phase values,
+// sums and the table rows its views read stay in the L1 cache.
+void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0,
+                                       int k1, double* L) const {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t N = static_cast<std::size_t>(std::max(0, n));
-  if (u_T_.size() < N) {
-    u_T_.resize(N);
-    u_ms_.resize(N);
+  for (std::size_t first = 0; first < N; first += kViewTile) {
+    const std::size_t m = std::min(kViewTile, N - first);
+    std::copy(phase + first * C * B, phase + (first + m) * C * B, phase_f_.begin());
+    std::fill(L_f_.begin(), L_f_.begin() + static_cast<std::ptrdiff_t>(m * B), 0.0f);
+    for (int k = std::max(0, k0); k < std::min(k1, steps_); ++k)
+      add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase_f_.data(), L_f_.data());
+    double* out = L + first * B;
+    for (std::size_t j = 0; j < m * B; ++j) out[j] += L_f_[j];
   }
-  double* u_T = u_T_.data();
-  double* u_ms = u_ms_.data();
-  for (int kk = std::max(0, k0); kk < std::min(k1, steps_); ++kk) {
-    const std::size_t k = static_cast<std::size_t>(kk);
-    const TransmittanceLut::RadiusCoord rc = radius_[k];
-    const double a = c_mu_[k] * mu_s0, c = c_nu_[k];
-    // Where each view's mu_s(t_k) falls in the transmittance and multiple-
-    // scattering tables (u_T < 0: the planet hides the sun).
-    const double ms_nodes = ms_ ? ms_->mu_s_samples() - 1 : 0.0;
-    for (std::size_t i = 0; i < N; ++i) {
-      const double mu_s = std::min(1.0, std::max(-1.0, a + c * nu[i]));
-      u_T[i] = transmittance_.mu_position(rc, mu_s);
-      u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
+}
+
+// One step for up to kViewTile views.
+SKYFARM_LUT_SIMD_CLONES
+void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const float* phase,
+                               float* L) const {
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  const TransmittanceLut::RadiusCoord rc = radius_[k];
+  const double a = c_mu_[k], c = c_nu_[k];
+  // Where each view's mu_s(t_k) falls in the transmittance and multiple-
+  // scattering tables (u_T < 0: the planet hides the sun).
+  const double ms_nodes = ms_ ? ms_->mu_s_samples() - 1 : 0.0;
+  double *__restrict u_T = u_T_.data(), *__restrict u_ms = u_ms_.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const double mu_s = std::min(1.0, std::max(-1.0, a * mu_s0[i] + c * nu[i]));
+    u_T[i] = transmittance_.mu_position(rc, mu_s);
+    u_ms[i] = 0.5 * (mu_s + 1.0) * ms_nodes;  // MultipleScatteringLut::mu_s_position
+  }
+  const float* wc = w_c_.data() + k * C * B;
+  const float* wms = w_ms_.data() + k * B;
+  if (ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer: one fused pass per view
+    const float* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
+    const float c1 = C == 2 ? 1.0f : 0.0f;
+    // Each view's nodes and fractions in both tables, in one vectorisable
+    // pass (u_T < 0: node 0, unused), and the range of nodes the views fall
+    // on: when they are fewer than the views, interpolate the tables to this
+    // step's radius once (radius_rows) and each view along mu only.
+    int *__restrict jt = node_T_.data(), *__restrict jm = node_ms_.data();
+    float *__restrict ft = frac_T_.data(), *__restrict fm = frac_ms_.data();
+    const int t_last = transmittance_.mu_samples() - 2, m_last = ms_->mu_s_samples() - 2;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int t = std::min(static_cast<int>(std::max(u_T[i], 0.0)), t_last);  // TransmittanceLut::node_of
+      const int m = std::min(static_cast<int>(u_ms[i]), m_last);
+      jt[i] = t;
+      jm[i] = m;
+      ft[i] = static_cast<float>(u_T[i] - t);
+      fm[i] = static_cast<float>(u_ms[i] - m);
     }
-    const double* wc = w_c_.data() + k * C * B;
-    const double* wms = w_ms_.data() + k * B;
-    for (std::size_t i = 0; i < N; ++i) {
-      double* Li = L + i * B;
-      const double* p = phase + i * C * B;
-      // One fused pass over the bins: J = T_sun sum_c w_c p_c + w_ms Psi_ms.
-      const bool lit = u_T[i] >= 0.0;
-      if (lit && ms_ && (C == 1 || C == 2)) {  // Earth's air and aerosols, or one scatterer
-        const lut::Bilinear t = transmittance_.bilinear(rc, u_T[i]), m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
-        const double* wc1 = C == 2 ? wc + B : wc;  // C == 1: a zero second term
-        const double* p1 = C == 2 ? p + B : p;
-        add_source(B, Li, wc, p, wc1, p1, C == 2 ? 1.0 : 0.0, t, wms, m);
-        continue;
+    int t_lo = t_last + 1, t_hi = -1, m_lo = m_last + 1, m_hi = -1;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (u_T[i] >= 0.0) {
+        t_lo = std::min(t_lo, jt[i]);
+        t_hi = std::max(t_hi, jt[i]);
       }
-      if (lit && C > 0) {  // the general case: any number of scatterers, with or without Psi_ms
-        for (std::size_t b = 0; b < B; ++b) w_phase_[b] = wc[b] * p[b];
-        for (std::size_t cc = 1; cc < C; ++cc)
-          for (std::size_t b = 0; b < B; ++b) w_phase_[b] += wc[cc * B + b] * p[cc * B + b];
-        transmittance_.lookup_weighted_add(rc, u_T[i], w_phase_.data(), Li);
-      }
-      if (ms_) ms_->lookup_weighted_add(ms_altitude_[k], u_ms[i], wms, Li);
+      m_lo = std::min(m_lo, jm[i]);
+      m_hi = std::max(m_hi, jm[i]);
     }
+    const std::size_t t_rows = t_lo <= t_hi ? static_cast<std::size_t>(t_hi - t_lo + 2) : 0;
+    const std::size_t m_rows = static_cast<std::size_t>(m_hi - m_lo + 2);
+    if (t_rows + m_rows <= n) {
+      float *T_rows = rows_T_.data(), *M_rows = rows_M_.data();
+      if (t_rows > 0) transmittance_.radius_rows(rc, static_cast<std::size_t>(t_lo), t_rows, T_rows);
+      ms_->altitude_rows(ms_altitude_[k], static_cast<std::size_t>(m_lo), m_rows, M_rows);
+      const std::size_t p1 = C == 2 ? B : 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const float* M = M_rows + static_cast<std::size_t>(jm[i] - m_lo) * B;
+        if (u_T[i] >= 0.0) {
+          const float* p = phase + i * C * B;
+          add_source_rows(B, L + i * B, wc, p, wc1, p + p1, c1, T_rows + static_cast<std::size_t>(jt[i] - t_lo) * B,
+                          ft[i], M, fm[i], wms);
+        } else {
+          add_weighted_row(B, L + i * B, M, fm[i], wms);
+        }
+      }
+      return;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      const lut::BilinearF m = ms_->bilinear(ms_altitude_[k], u_ms[i]);
+      if (u_T[i] >= 0.0) {
+        const float* p = phase + i * C * B;
+        add_source(B, L + i * B, wc, p, wc1, C == 2 ? p + B : p, c1, transmittance_.bilinear(rc, u_T[i]), wms, m);
+      } else {
+        m.weighted_add(bins_, wms, L + i * B);
+      }
+    }
+    return;
+  }
+  float* w_phase = w_phase_.data();
+  for (std::size_t i = 0; i < n; ++i) {  // the general case: any number of scatterers, with or without Psi_ms
+    float* Li = L + i * B;
+    const float* p = phase + i * C * B;
+    if (u_T[i] >= 0.0 && C > 0) {
+      for (std::size_t b = 0; b < B; ++b) w_phase[b] = wc[b] * p[b];
+      for (std::size_t cc = 1; cc < C; ++cc)
+        for (std::size_t b = 0; b < B; ++b) w_phase[b] += wc[cc * B + b] * p[cc * B + b];
+      transmittance_.bilinear(rc, u_T[i]).weighted_add(bins_, w_phase, Li);
+    }
+    if (ms_) ms_->bilinear(ms_altitude_[k], u_ms[i]).weighted_add(bins_, wms, Li);
   }
 }
 

@@ -18,6 +18,15 @@
 // x_t . s = r_0 mu_s0 + t nu, so the sun's zenith cosine at x_t is
 //   mu_s(t) = (r_0 mu_s0 + t nu) / r_t,
 // which depends on the sun only through mu_s0 (at x_0) and nu.
+//
+// Precision and speed: geometry, positions in the tables and T(x_0, x_k)
+// are double; the per-step weights, the phase values and the sums over a
+// call's steps are single precision, like the transmittance and multiple-
+// scattering tables (bilinear.h), and are added to the caller's doubles once
+// per call.  Views go in tiles of 32 (their data stay in the L1 cache), and
+// when a tile's views fall on fewer table nodes than there are views, both
+// tables are interpolated to the step's radius once and each view along
+// mu_s only (add_step).
 #pragma once
 #include <span>
 #include <vector>
@@ -59,11 +68,17 @@ class ScatteringMarch {
   // L + i * bins.  The look-up positions of all n views are computed in one
   // vectorisable pass per step.
   void add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1, double* L) const;
+  // The same with a sun per view: mu_s0[i] (the ground-irradiance table's
+  // suns, one per view).
+  void add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0, int k1,
+                        double* L) const;
   // L[b] += the ground's reflected radiance times T(x_0, x_g), if the ray ends on it.
   void add_ground(double nu, double mu_s0, double* L) const;
 
  private:
   void prepare_steps(double r0, double mu, bool ends_on_ground);
+  void add_step(std::size_t k, std::size_t n, const double* nu, const double* mu_s0, const float* phase,
+                float* L) const;
 
   const MediumTable& medium_;
   const TransmittanceLut& transmittance_;
@@ -75,13 +90,16 @@ class ScatteringMarch {
   std::vector<double> t_mid_, dt_;
   // Per step: weights T(x_0, x_k-) int_k exp(-sigma_t s) ds sigma_s,c ([k][c][b])
   // and the same with the total sigma_s ([k][b]); T before each step ([k][b]).
-  std::vector<double> w_c_, w_ms_, T_before_;
+  std::vector<float> w_c_, w_ms_;  // single precision, as the tables they weight (bilinear.h)
+  std::vector<double> T_before_;
   std::vector<TransmittanceLut::RadiusCoord> radius_;
   std::vector<MultipleScatteringLut::AltitudeCoord> ms_altitude_;
   std::vector<double> c_mu_, c_nu_;      // mu_s(t_k) = c_mu mu_s0 + c_nu nu
   std::vector<double> s_t_, s_s_, s_c_;  // scratch per step
   // Scratch of the look-ups (a ScatteringMarch is used by one thread at a time).
-  mutable std::vector<double> w_phase_, tmp_, u_T_, u_ms_;
+  mutable std::vector<double> tmp_, u_T_, u_ms_, mu0_;
+  mutable std::vector<float> w_phase_, phase_f_, L_f_, rows_T_, rows_M_, frac_T_, frac_ms_;
+  mutable std::vector<int> node_T_, node_ms_;
 };
 
 }  // namespace skyfarm

@@ -25,8 +25,10 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/core/math.h"
+#include "common/lut/vector_math.h"
 
 namespace skyfarm::lut {
 
@@ -47,12 +49,16 @@ inline double in_scattering_integral(double sigma_t, double dt) {
 // Both from a single exponential (the hot loops call this): returns the
 // transmittance and stores the integral in *integral.  For x >= 1e-4 the
 // difference 1 - exp(-x) loses at most eps/x ~ 2e-12 relative to
-// cancellation, far below what the tables resolve.
+// cancellation, far below what the tables resolve.  Branch-free, with
+// lut::exp_inline, so that loops over bins vectorise: both branches are
+// evaluated (the quotient's denominator kept > 0) and one is selected.
 inline double T_and_in_scattering_integral(double sigma_t, double dt, double* integral) {
   const double s = std::max(0.0, sigma_t), d = std::max(0.0, dt);
   const double x = s * d;
-  const double t = std::exp(-x);
-  *integral = x < 1e-4 ? d * (1.0 - x * (0.5 - x * (1.0 / 6.0))) : (1.0 - t) / s;
+  const double t = exp_inline(-x);
+  const double series = d * (1.0 - x * (0.5 - x * (1.0 / 6.0)));
+  const double quotient = (1.0 - t) / std::max(s, std::numeric_limits<double>::min());
+  *integral = x < 1e-4 ? series : quotient;
   return t;
 }
 

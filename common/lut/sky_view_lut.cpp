@@ -23,12 +23,12 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
   const double r = std::clamp(observer_radius_m, R, R_top);
   s.mapping_ = lut::ViewMapping(r, R, zenith_rows, azimuth_columns);
   const std::size_t B = static_cast<std::size_t>(s.bins_), cols = static_cast<std::size_t>(azimuth_columns);
-  s.values_.assign(static_cast<std::size_t>(s.mapping_.rows()) * cols * B, 0.0);
+  s.values_.assign(static_cast<std::size_t>(s.mapping_.rows()) * cols * B, 0.0f);
   const double sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
 
   ScatteringMarch march(medium, transmittance, &multiple_scattering, &ground);
   const std::size_t CB = static_cast<std::size_t>(medium.scatterers()) * B;
-  std::vector<double> nu(cols), phase(cols * CB);
+  std::vector<double> nu(cols), phase(cols * CB), L(cols * B);
   for (int row = 0; row < s.mapping_.rows(); ++row) {
     bool hits_ground;
     const double theta = s.mapping_.zenith_of_row(row, &hits_ground);
@@ -40,12 +40,13 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
       nu[col] = mu * mu_s + sin_theta * sin_s * s.mapping_.cos_phi_of_column(static_cast<int>(col));
       medium.phase(nu[col], phase.data() + col * CB);
     }
-    double* L = s.values_.data() + static_cast<std::size_t>(row) * cols * B;
-    march.add_inscattering(static_cast<int>(cols), nu.data(), phase.data(), mu_s, 0, march.steps(), L);
+    std::fill(L.begin(), L.end(), 0.0);
+    march.add_inscattering(static_cast<int>(cols), nu.data(), phase.data(), mu_s, 0, march.steps(), L.data());
+    float* out = s.values_.data() + static_cast<std::size_t>(row) * cols * B;
     for (std::size_t col = 0; col < cols; ++col) {
-      double* Lc = L + col * B;
+      double* Lc = L.data() + col * B;
       march.add_ground(nu[col], mu_s, Lc);
-      for (std::size_t b = 0; b < B; ++b) Lc[b] *= sun_irradiance[b];
+      for (std::size_t b = 0; b < B; ++b) out[col * B + b] = static_cast<float>(Lc[b] * sun_irradiance[b]);
     }
   }
   return s;
@@ -54,7 +55,7 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
 void SkyViewLut::lookup(double mu, double cos_phi, double* out) const {
   const lut::ViewMapping::Position p = mapping_.locate(mu, cos_phi);
   const std::size_t B = static_cast<std::size_t>(bins_), cols = static_cast<std::size_t>(mapping_.n_azimuth);
-  lut::Bilinear(values_.data() + (p.row * cols + p.column) * B, cols * B, B, p.f_row, p.f_column).eval(bins_, out);
+  lut::BilinearF(values_.data() + (p.row * cols + p.column) * B, cols * B, B, p.f_row, p.f_column).eval(bins_, out);
 }
 
 }  // namespace skyfarm

@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
+#include <vector>
 
 #include "common/core/math.h"
 #include "common/lut/bilinear.h"
 #include "common/lut/invalid_argument.h"
 #include "common/lut/shell_geometry.h"
 #include "common/lut/simd_clones.h"
+#include "common/lut/vector_math.h"
 
 namespace skyfarm {
 
@@ -17,6 +20,116 @@ namespace {
 // The nodes are equally spaced in v = 1 - (1 - x_mu)^(1/4) (mu_position, in
 // the header: two square roots, cheaper in the look-ups than a cube root).
 double x_mu_from_v(double v) { return 1.0 - sqr(sqr(1.0 - v)); }
+
+// The optical depth quadrature (header): per monotone part [s_a, s_b] the
+// samples s = s_a + (s_b - s_a) u_k^2, k = 1..n, with weights
+// (s_b - s_a) weight_k, weight_k = Simpson's 1, 4, 2, ..., 4, 1 / (3 n)
+// times ds/du / (s_b - s_a) = 2 u_k.  The sums run over the medium's
+// extinction terms (medium_table.h), not over the bins: 8 values per sample
+// for the Earth instead of 32 bins.
+class OpticalDepthQuadrature {
+ public:
+  OpticalDepthQuadrature(const MediumTable& medium, int steps)
+      : medium_(medium), n_(steps + (steps % 2)), u2_(n_), weight_(n_), node_(n_), w0_(n_), w1_(n_) {
+    for (int k = 1; k <= n_; ++k) {  // k = 0 has ds/du = 0
+      const double u = static_cast<double>(k) / n_;
+      const std::size_t j = static_cast<std::size_t>(k - 1);
+      u2_[j] = u * u;
+      weight_[j] = (k == n_ ? 1.0 : (k % 2 == 1 ? 4.0 : 2.0)) / (3.0 * n_) * 2.0 * u;
+    }
+  }
+
+  // terms[k] = int rho_k ds from radius r along mu to the top (rays into the
+  // ground as if the planet were absent), k < medium.padded_terms().
+  [[gnu::always_inline]] void terms_to_top(double r, double mu, double* terms) {
+    const double R = medium_.planet_radius_m(), R_top = medium_.top_radius_m();
+    std::fill(terms, terms + medium_.padded_terms(), 0.0);
+    r = std::clamp(r, R, R_top);
+    const double l = r * std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
+    const double s0 = r * mu;
+    const double s_top = std::sqrt(std::max(0.0, (R_top - l) * (R_top + l)));
+    // A ray that descends to the closest approach first has two ascending
+    // parts in |s|.  (One call site in a loop: with a = 0 as a constant, GCC
+    // specialises add_part and leaves that copy's loop scalar.)
+    const double from[2] = {std::max(s0, 0.0), 0.0}, to[2] = {s0 < 0.0 ? -s0 : s_top, s_top};
+    for (int part = 0; part < (s0 < 0.0 ? 2 : 1); ++part) add_part(l, from[part], to[part], terms);
+  }
+
+  // tau[b] from the terms.
+  [[gnu::always_inline]] void expand(const double* terms, double* tau) const {
+    const std::size_t B = static_cast<std::size_t>(medium_.bins());
+    const double* spectra = medium_.term_spectra();
+    std::fill(tau, tau + B, 0.0);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(medium_.term_count()); ++k) {
+      const double t = terms[k];
+      const double* kappa = spectra + k * B;
+      for (std::size_t b = 0; b < B; ++b) tau[b] += t * kappa[b];
+    }
+  }
+
+ private:
+  // One part at distances [a, b] past the closest approach (radius l): the
+  // samples' altitude nodes and weights in one vectorisable pass, then the
+  // terms' profiles interpolated and summed.
+  [[gnu::always_inline]] void add_part(double l, double a, double b, double* terms) {
+    if (!(b > a)) return;
+    const double R = medium_.planet_radius_m(), inv_dh = 1.0 / medium_.altitude_step_m();
+    const double top_node = medium_.altitude_samples() - 1;
+    const int last_cell = medium_.altitude_samples() - 2;
+    const double d = b - a, l2 = l * l;
+    // (Locals, not members, in the loops: the compiler cannot prove that the
+    // stores leave *this alone, and would not vectorise.)
+    const std::size_t n = static_cast<std::size_t>(n_);
+    const double *u2 = u2_.data(), *weight = weight_.data();
+    int* __restrict node = node_.data();
+    double *__restrict w0 = w0_.data(), *__restrict w1 = w1_.data();
+    for (std::size_t k = 0; k < n; ++k) {
+      const double s = a + d * u2[k];
+      const double h = lut::sqrt_inline(l2 + s * s) - R;
+      const double x = std::min(std::max(h * inv_dh, 0.0), top_node);  // MediumTable::locate
+      const int i = std::min(static_cast<int>(x), last_cell);
+      const double f = x - i, w = d * weight[k];
+      node[k] = i;
+      w0[k] = w * (1.0 - f);
+      w1[k] = w * f;
+    }
+    // Eight terms at a time, in a local accumulator that stays in registers
+    // (through memory, every sample would wait for the previous store).
+    const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
+    for (std::size_t c = 0; c < K; c += 8) {
+      double acc[8];
+      for (std::size_t j = 0; j < 8; ++j) acc[j] = terms[c + j];
+      for (std::size_t k = 0; k < n; ++k) {
+        const double* p0 = medium_.term_block(static_cast<std::size_t>(node[k]), c);
+        const double* p1 = medium_.term_block(static_cast<std::size_t>(node[k]) + 1, c);
+        const double a0 = w0[k], a1 = w1[k];
+        for (std::size_t j = 0; j < 8; ++j) acc[j] += a0 * p0[j] + a1 * p1[j];
+      }
+      for (std::size_t j = 0; j < 8; ++j) terms[c + j] = acc[j];
+    }
+  }
+
+  const MediumTable& medium_;
+  int n_;
+  std::vector<double> u2_, weight_;
+  std::vector<int> node_;
+  std::vector<double> w0_, w1_;
+};
+
+// One row of the table (radius node j): every mu node's transmittance.
+SKYFARM_LUT_SIMD_CLONES
+void fill_row(OpticalDepthQuadrature& quadrature, std::span<const double> r, std::span<const double> mu,
+              int bins, double* terms, double* tau, float* out) {
+  const std::size_t B = static_cast<std::size_t>(bins);
+  for (std::size_t i = 0; i < mu.size(); ++i) {
+    quadrature.terms_to_top(r[i], mu[i], terms);
+    quadrature.expand(terms, tau);
+    for (std::size_t b = 0; b < B; ++b) tau[b] = lut::exp_inline(-tau[b]);
+    float* T = out + i * B;
+    for (std::size_t b = 0; b < B; ++b) T[b] = static_cast<float>(tau[b]);  // (apart: GCC keeps a fused loop scalar)
+  }
+}
+
 }  // namespace
 
 TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_samples, int r_samples, int steps) {
@@ -32,17 +145,17 @@ TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_sampl
   t.R_top_ = medium.top_radius_m();
   t.H_ = std::sqrt((t.R_top_ - t.R_) * (t.R_top_ + t.R_));
   const std::size_t B = static_cast<std::size_t>(t.bins_);
-  t.values_.assign(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B, 0.0);
-  std::vector<double> tau(B);
-  for (int j = 0; j < r_samples; ++j)
-    for (int i = 0; i < mu_samples; ++i) {
-      double r, mu;
-      t.r_mu_from_unit(static_cast<double>(j) / (r_samples - 1), x_mu_from_v(static_cast<double>(i) / (mu_samples - 1)),
-                       &r, &mu);
-      optical_depth_to_top(medium, r, mu, t.steps_, tau.data());
-      double* out = t.values_.data() + (static_cast<std::size_t>(j) * mu_samples + i) * B;
-      for (std::size_t b = 0; b < B; ++b) out[b] = std::exp(-tau[b]);
-    }
+  t.values_.assign(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B, 0.0f);
+  OpticalDepthQuadrature quadrature(medium, t.steps_);
+  std::vector<double> terms(static_cast<std::size_t>(medium.padded_terms())), tau(B);
+  std::vector<double> r(static_cast<std::size_t>(mu_samples)), mu(static_cast<std::size_t>(mu_samples));
+  for (int j = 0; j < r_samples; ++j) {
+    for (std::size_t i = 0; i < mu.size(); ++i)
+      t.r_mu_from_unit(static_cast<double>(j) / (r_samples - 1),
+                       x_mu_from_v(static_cast<double>(i) / (mu_samples - 1)), &r[i], &mu[i]);
+    fill_row(quadrature, r, mu, t.bins_, terms.data(), tau.data(),
+             t.values_.data() + static_cast<std::size_t>(j) * mu.size() * B);
+  }
   return t;
 }
 
@@ -97,36 +210,11 @@ void TransmittanceLut::lookup_weighted_add(const RadiusCoord& rc, double u, cons
   bilinear(rc, u).weighted_add(bins_, weight, acc);
 }
 
-// tau = int sigma_t ds over each monotone part, s = s_a + (s_b - s_a) u^2,
-// ds = 2 (s_b - s_a) u du, Simpson's rule in u (weights 1, 4, 2, ..., 4, 1
-// times 1/(3n)).
-SKYFARM_LUT_SIMD_CLONES
 void TransmittanceLut::optical_depth_to_top(const MediumTable& medium, double r, double mu, int steps, double* tau) {
-  const int B = medium.bins();
-  const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
-  std::fill(tau, tau + B, 0.0);
-  r = std::clamp(r, R, R_top);
-  const double l = r * std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
-  const double s0 = r * mu;
-  const double s_top = std::sqrt(std::max(0.0, (R_top - l) * (R_top + l)));
-  const int n = steps + (steps % 2);
-  auto part = [&](double a, double b) {
-    if (!(b > a)) return;
-    for (int k = 1; k <= n; ++k) {  // k = 0 has ds/du = 0
-      const double u = static_cast<double>(k) / n;
-      const double s = a + (b - a) * u * u;
-      const double simpson = (k == n ? 1.0 : (k % 2 == 1 ? 4.0 : 2.0)) / (3.0 * n);
-      const double w = simpson * 2.0 * (b - a) * u;
-      const double h = std::sqrt(l * l + s * s) - R;
-      medium.add_sigma_t(medium.locate(h), w, tau);
-    }
-  };
-  if (s0 < 0.0) {  // descends to the closest approach first: two ascending parts in |s|
-    part(0.0, -s0);
-    part(0.0, s_top);
-  } else {
-    part(s0, s_top);
-  }
+  OpticalDepthQuadrature quadrature(medium, steps);
+  std::vector<double> terms(static_cast<std::size_t>(medium.padded_terms()));
+  quadrature.terms_to_top(r, mu, terms.data());
+  quadrature.expand(terms.data(), tau);
 }
 
 }  // namespace skyfarm

@@ -24,14 +24,17 @@
 // power (measured on the Earth preset, 256 x 128 nodes, worst error relative
 // to the test's tolerance max(0.5 % T, 1e-4): 0.50 with this warp, 0.56 with
 // a cube root, 1.2 with a square root, 25 without).  Values are stored at the nodes
-// (v = k / (n - 1), x_r = j / (n - 1)) and interpolated bilinearly.  Rays below the horizon get T = 0 (the planet
+// (v = k / (n - 1), x_r = j / (n - 1)), in single precision (bilinear.h), and
+// interpolated bilinearly.  Rays below the horizon get T = 0 (the planet
 // hides the sun; a hard shadow: the disk's penumbra is not modelled).
 //
 // Quadrature: along the ray's line, s is the distance past the closest
 // approach to the centre (radius l = r sqrt(1 - mu^2)), r(s) = sqrt(l^2 + s^2);
 // each monotone part [s_a, s_b] (s_a >= 0) is mapped by s = s_a + (s_b -
 // s_a) u^2, so that the samples crowd where the air is densest, and the
-// optical depth int sigma_t ds is summed by Simpson's rule in u.
+// optical depth int sigma_t ds is summed by Simpson's rule in u, for each of
+// the medium's extinction terms (medium_table.h: 7 profiles for the Earth,
+// whatever the number of bins), then expanded to the bins once per node.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -40,6 +43,7 @@
 
 #include "common/lut/bilinear.h"
 #include "common/lut/medium_table.h"
+#include "common/lut/vector_math.h"
 
 namespace skyfarm {
 
@@ -49,30 +53,55 @@ class TransmittanceLut {
 
   // Where (r, mu) falls in the table, in two parts: the radius part
   // (locate_r, reused for every mu at that radius) and the fractional node
-  // position u in [0, mu_samples - 1] along mu (mu_position: inline and
-  // branch-free so that loops over many mu vectorise), -1 for a ray that
-  // meets the ground (T = 0).
+  // position u in [0, mu_samples - 1] along mu (mu_position), -1 for a ray
+  // that meets the ground (T = 0).  mu_position is inline and has a single
+  // select so that the loops over many mu (a table row's views, every sun
+  // of the multiple-scattering table) vectorise: the ground test is d >
+  // d_max, i.e. x_mu > 1 before clamping (the distance to the top grows as
+  // mu falls, and the horizon ray has d_max), which is lut::ray_hits_ground
+  // up to rounding (the 1e-12 margin keeps the horizontal ray from the
+  // ground, mu = 0, unblocked).
   struct RadiusCoord {
     double r, r2, top_c, ground_c;  // r, r^2, R_top^2 - r^2, r^2 - R^2 (as (a - b)(a + b))
     double d_min, inv_range;        // R_top - r, 1 / (d_max - d_min)
-    std::size_t row;                // offset of node (j, 0), in doubles
+    std::size_t row;                // offset of node (j, 0), in values
     double fj;                      // weight of row j + 1
   };
   RadiusCoord locate_r(double r) const;
   double mu_position(const RadiusCoord& rc, double mu) const {
-    const double r2mu2 = rc.r2 * mu * mu;
-    const double d = -rc.r * mu + std::sqrt(std::max(0.0, r2mu2 + rc.top_c));  // distance to the top
-    const double x_mu = std::min(1.0, std::max(0.0, (d - rc.d_min) * rc.inv_range));
-    const double u = (1.0 - std::sqrt(std::sqrt(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
-    const bool hits_ground = (mu < 0.0) & (r2mu2 >= rc.ground_c);             // lut::ray_hits_ground
-    return hits_ground ? -1.0 : u;
+    const double d = -rc.r * mu + lut::sqrt_inline(rc.r2 * mu * mu + rc.top_c);  // distance to the top
+    const double x = (d - rc.d_min) * rc.inv_range;
+    const double x_mu = std::min(1.0, std::max(0.0, x));
+    const double u = (1.0 - lut::sqrt_inline(lut::sqrt_inline(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
+    return x > 1.0 + 1e-12 ? -1.0 : u;
   }
   // The four nodes and weights around (rc, u >= 0), for fused loops.
-  lut::Bilinear bilinear(const RadiusCoord& rc, double u) const {
+  lut::BilinearF bilinear(const RadiusCoord& rc, double u) const {
     const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_ - 2));
     const std::size_t B = static_cast<std::size_t>(bins_);
-    return lut::Bilinear(values_.data() + rc.row + i * B, static_cast<std::size_t>(n_mu_) * B, B, rc.fj,
-                         u - static_cast<double>(i));
+    return lut::BilinearF(values_.data() + rc.row + i * B, static_cast<std::size_t>(n_mu_) * B, B, rc.fj,
+                          u - static_cast<double>(i));
+  }
+  // The radius half of that interpolation for the mu nodes [first, first +
+  // count): out[m * bins + b] = T at rc's radius and node first + m.  A
+  // march step whose many views fall on few nodes builds these once and
+  // interpolates along mu only (node_of(u), then linear).
+  void radius_rows(const RadiusCoord& rc, std::size_t first, std::size_t count, float* __restrict out) const {
+    const std::size_t B = static_cast<std::size_t>(bins_), n = count * B;
+    const float* __restrict a = values_.data() + rc.row + first * B;
+    const float* __restrict b = a + static_cast<std::size_t>(n_mu_) * B;
+    const float f = static_cast<float>(rc.fj), g = 1.0f - f;
+    for (std::size_t k = 0; k < n; ++k) out[k] = g * a[k] + f * b[k];
+  }
+  // For loops that build their own bilinear weights: the values at rc's
+  // row and mu node i, and the distance (in values) to the next row.
+  const float* node_values(const RadiusCoord& rc, std::size_t i) const {
+    return values_.data() + rc.row + i * static_cast<std::size_t>(bins_);
+  }
+  std::size_t radius_stride() const { return static_cast<std::size_t>(n_mu_) * static_cast<std::size_t>(bins_); }
+  // The node i (u in [i, i + 1]) that bilinear() interpolates from, u >= 0.
+  std::size_t node_of(double u) const {
+    return std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(n_mu_ - 2));
   }
   // T per bin (bilinear; 0 when u < 0).
   void lookup(const RadiusCoord& rc, double u, double* out) const;
@@ -95,12 +124,12 @@ class TransmittanceLut {
 
   int mu_samples() const { return n_mu_; }
   int r_samples() const { return n_r_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(double); }
+  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
 
  private:
   int bins_ = 0, n_mu_ = 0, n_r_ = 0, steps_ = 0;
   double R_ = 0.0, R_top_ = 0.0, H_ = 0.0;
-  std::vector<double> values_;  // [x_r node][x_mu node][bin]
+  std::vector<float> values_;  // [x_r node][x_mu node][bin], single precision (bilinear.h)
 };
 
 }  // namespace skyfarm

@@ -62,5 +62,41 @@ TEST(LutMediumTable, TabulatedPhaseFunctionsMatchTheExactOnes) {
   }
 }
 
+// The extinction as separable terms (medium_table.h): the Earth preset has
+// air, aerosols and the ozone temperature columns that some altitude uses,
+// and the terms add up to sigma_t at every node (to rounding).
+TEST(LutMediumTable, ExtinctionTermsAddUpToSigmaT) {
+  const Atmosphere atm = build_atmosphere(AtmosphereSpec{});
+  const SpectralGrid grid(360.0, 830.0, 32);
+  const MediumTable m = MediumTable::build(atm, grid, 512);
+  EXPECT_GE(m.term_count(), 4);  // air, aerosols, >= 2 ozone columns
+  EXPECT_LE(m.term_count(), 7);
+  EXPECT_EQ(m.padded_terms() % 8, 0);
+  const std::size_t K = static_cast<std::size_t>(m.padded_terms()), B = 32;
+  std::vector<double> s_t(B);
+  for (int i = 0; i < m.altitude_samples(); ++i) {
+    m.sigma_t(MediumTable::Node{static_cast<std::size_t>(i), 0.0}, s_t.data());
+    for (std::size_t b = 0; b < B; ++b) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < K; ++k)
+        sum += m.term_block(static_cast<std::size_t>(i), k / 8 * 8)[k % 8] * m.term_spectra()[k * B + b];
+      EXPECT_NEAR(sum, s_t[b], 1e-13 * s_t[b]) << "node " << i << " bin " << b;
+    }
+  }
+  AtmosphereSpec custom;
+  custom.preset = AtmospherePreset::kCustom;
+  ConstituentSpec a, b;
+  a.name = "scatterer";
+  a.density = ExponentialDensity{8000.0};
+  a.scattering_per_m = {{400.0, 700.0}, {1e-5, 2e-6}};
+  b.name = "absorber";
+  b.density = ExponentialDensity{1000.0};
+  b.absorption_per_m = {{550.0}, {3e-6}};
+  custom.constituents = {a, b};
+  const MediumTable two = MediumTable::build(build_atmosphere(custom), grid, 64);
+  EXPECT_EQ(two.term_count(), 2);
+  EXPECT_EQ(two.padded_terms(), 8);
+}
+
 }  // namespace
 }  // namespace skyfarm

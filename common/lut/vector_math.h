@@ -1,0 +1,84 @@
+// exp and sqrt written as plain arithmetic, so that the LUT builders' loops
+// that call them vectorise.
+//
+// Why: GCC compiles std::sqrt and std::exp to calls that may set errno, and
+// a loop with such a call stays scalar unless the whole translation unit is
+// built with -fno-math-errno (GCC 12 ignores it as a function attribute or
+// pragma).  The tables' builders spend most of their time in loops over
+// march steps and spectral bins that need one or both (a step's radius,
+// a look-up's position, a segment's transmittance), so these two replace
+// the library calls there.  Both use + - * / and integer operations on the
+// bit patterns only (no FMA, no table), so a vectorised clone and the scalar
+// code give the same bits (simd_clones.h), and a table built twice is
+// bit-identical.
+//
+//   exp_inline(x)   e^x, x clamped to [-746, 709]; relative error < 3e-16
+//                   for normal results (measured against std::exp in
+//                   tests/common/lut/vector_math_test.cpp), subnormal results
+//                   rounded as usual, 0 below -745.2 (and for -inf), NaN for
+//                   NaN.  Cody & Waite's reduction x = n ln 2 + r,
+//                   |r| <= ln(2)/2 (ln 2 split in a high part with 21
+//                   trailing zero bits, so n ln2_hi is exact), e^r by its
+//                   Taylor series to r^13 (remainder < 2e-16 relative), and
+//                   2^n from bit patterns.
+//   sqrt_inline(x)  sqrt(max(x, 0)): within 1 ulp of std::sqrt for normal
+//                   x (same test), 0 for x <= 0, NaN for NaN; inaccurate
+//                   (but below 1.5e-154) for subnormal x.  The bit-pattern
+//                   estimate of 1/sqrt(x) (error < 3.5 %), three Newton
+//                   steps on 1/sqrt(x) (error < 4e-11), then one on sqrt(x)
+//                   itself, which squares the error.
+// Neither has a branch or a select: GCC sinks the work behind a select into
+// a conditional block, which it then does not vectorise.
+#pragma once
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <limits>
+
+namespace skyfarm::lut {
+
+inline double exp_inline(double x) {
+  constexpr double kLog2e = 1.4426950408889634074;
+  constexpr double kShifter = 0x1.8p52;  // adding it rounds to an integer, kept in the low bits
+  constexpr double kLn2Hi = 0x1.62e42fee00000p-1, kLn2Lo = 0x1.a39ef35793c76p-33;
+  const double xc = std::max(std::min(x, 709.0), -746.0);  // NaN passes through
+  const double t = xc * kLog2e + kShifter;
+  const double n = t - kShifter;
+  const double r = (xc - n * kLn2Hi) - n * kLn2Lo;
+  double p = 1.0 / 6227020800.0;  // 1/13!
+  p = p * r + 1.0 / 479001600.0;
+  p = p * r + 1.0 / 39916800.0;
+  p = p * r + 1.0 / 3628800.0;
+  p = p * r + 1.0 / 362880.0;
+  p = p * r + 1.0 / 40320.0;
+  p = p * r + 1.0 / 5040.0;
+  p = p * r + 1.0 / 720.0;
+  p = p * r + 1.0 / 120.0;
+  p = p * r + 1.0 / 24.0;
+  p = p * r + 1.0 / 6.0;
+  p = p * r + 0.5;
+  p = p * r + 1.0;
+  p = p * r + 1.0;
+  // 2^n = 2^n1 2^n2 with n1 = floor(n / 2): both factors are normal doubles
+  // for n in [-1076, 1023], and the second product rounds to a subnormal or
+  // to 0 as e^x does (no select, which would keep the loops scalar).
+  const std::int64_t k = static_cast<std::int64_t>(std::bit_cast<std::uint64_t>(t) - std::bit_cast<std::uint64_t>(kShifter));
+  const std::int64_t k1 = k >> 1, k2 = k - k1;
+  const double s1 = std::bit_cast<double>(static_cast<std::uint64_t>(k1 + 1023) << 52);
+  const double s2 = std::bit_cast<double>(static_cast<std::uint64_t>(k2 + 1023) << 52);
+  return (p * s1) * s2;
+}
+
+inline double sqrt_inline(double x) {
+  const double xc = std::max(x, 0.0);                                        // NaN passes through
+  const double xe = std::max(xc, std::numeric_limits<double>::min());  // for the estimate
+  double y = std::bit_cast<double>(0x5fe6eb50c7b537a9u - (std::bit_cast<std::uint64_t>(xe) >> 1));
+  const double half = 0.5 * xe;
+  y = y * (1.5 - half * y * y);  // error 1.8e-3
+  y = y * (1.5 - half * y * y);  // 4.6e-6
+  y = y * (1.5 - half * y * y);  // 3.2e-11, squared by the last step
+  const double s = xc * y;      // 0 for x <= 0
+  return s + 0.5 * y * (xc - s * s);
+}
+
+}  // namespace skyfarm::lut
