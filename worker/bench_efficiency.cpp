@@ -87,6 +87,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       suns.push_back(std::atof(args[++i].c_str()));
     } else if (args[i] == "--shadow-scale" && i + 1 < args.size()) {
       options.shadow_majorant_scale = std::max(1.0, std::atof(args[++i].c_str()));
+    } else if (args[i] == "--max-camera-scale" && i + 1 < args.size()) {
+      options.max_camera_majorant_scale = std::atof(args[++i].c_str());
     } else if (args[i] == "--max-depth" && i + 1 < args.size()) {
       options.max_depth = std::atoi(args[++i].c_str());
     } else if (args[i] == "--forced-segments" && i + 1 < args.size()) {
