@@ -17,6 +17,7 @@
 #include "common/lut/lut_sky.h"
 #include "common/render/radiance_probe.h"
 #include "tests/support/sun_specs.h"
+#include "tests/support/thin_layer.h"
 
 namespace skyfarm {
 namespace {
@@ -74,16 +75,7 @@ TEST(LutSkyView, MatchesTheReferenceMarch) {
 // measured 0.36 %) to 0.6 %.
 TEST(LutSingleScattering, ThinLayerMatchesTheIntegral) {
   const double sigma_s = 5e-8, top = 2000.0, g = 0.5;
-  AtmosphereSpec spec;
-  spec.preset = AtmospherePreset::kCustom;
-  spec.top_altitude_m = top;
-  spec.ground_albedo = 0.0;
-  ConstituentSpec layer;
-  layer.name = "layer";
-  layer.density = LayersDensity{{{0.0, 0.0, 0.0, 0.0, 1.0}}};
-  layer.scattering_per_m = {{550.0}, {sigma_s}};
-  layer.phase = HenyeyGreensteinPhaseSpec{g};
-  spec.constituents = {layer};
+  const AtmosphereSpec spec = testing::thin_hg_layer(sigma_s, top, g);
   const Atmosphere atm = build_atmosphere(spec);
   const Sun sun(30.0, 180.0, 0.0, PiecewiseLinear::constant(1.0));
   LutResolution res;

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/sun_specs.h"
+#include "tests/support/thin_layer.h"
 
 #include <cmath>
 #include <glm/geometric.hpp>
@@ -98,16 +99,7 @@ TEST(IntegratorPhysics, DirectSunThroughAbsorberMatchesBeerLambertAtAllWavelengt
 // towards the sun, evaluated exactly on the sphere.
 TEST(IntegratorPhysics, ThinLayerSingleScatteringMatchesIntegral) {
   const double sigma_s = 5e-6, top = 2000.0, g = 0.5;
-  AtmosphereSpec spec;
-  spec.preset = AtmospherePreset::kCustom;
-  spec.top_altitude_m = top;
-  spec.ground_albedo = 0.0;
-  ConstituentSpec layer;
-  layer.name = "layer";
-  layer.density = LayersDensity{{{0.0, 0.0, 0.0, 0.0, 1.0}}};
-  layer.scattering_per_m = {{550.0}, {sigma_s}};
-  layer.phase = HenyeyGreensteinPhaseSpec{g};
-  spec.constituents = {layer};
+  const AtmosphereSpec spec = testing::thin_hg_layer(sigma_s, top, g);
   const Scene scene = Scene::from_specs(spec, sun_at(30.0, 180.0, 0.0), Location{}, std::nullopt, 500.0, 600.0);
   const double lambda = 550.0;
   const glm::dvec3 view = direction_from_zenith_azimuth(60.0 * kDegToRad, 0.0);
