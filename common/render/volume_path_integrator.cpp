@@ -81,11 +81,8 @@ VolumePathIntegrator::VolumePathIntegrator(const Scene& scene, IntegratorOptions
 // weighs each wavelength by the pdf its own hero technique would have had, so
 // all four techniques must use the same majorants.  It is therefore set from
 // the largest majorant optical depth of the path's wavelengths.
-double VolumePathIntegrator::camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
-                                                  const std::array<std::size_t, kWavelengthsPerPath>& bins) const {
+double VolumePathIntegrator::camera_majorant_scale(double tau) const {
   if (options_.max_camera_majorant_scale <= 1.0) return 1.0;
-  const AtmosphereMedium& medium = scene_.medium();
-  const double tau = majorant_optical_depth(medium, medium.fine_shells(), ray, t_begin, t_end, bins).max();
   if (tau * options_.max_camera_majorant_scale <= options_.camera_target_collisions)
     return options_.max_camera_majorant_scale;
   return std::max(1.0, options_.camera_target_collisions / tau);
@@ -143,9 +140,16 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
 
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
-      const double scale = depth == 0 ? camera_majorant_scale(ray, extent.t_begin, extent.t_end, path.bins) : 1.0;
+      // The segment's majorant optical depth, once, for the camera ray's
+      // inflation and the forced collision.
+      const bool forced = depth < options_.forced_collision_segments;
+      const SampledSpectrum tau_maj =
+          depth == 0 || forced
+              ? majorant_optical_depth(medium, medium.fine_shells(), ray, extent.t_begin, extent.t_end, path.bins)
+              : SampledSpectrum(0.0);
+      const double scale = depth == 0 ? camera_majorant_scale(tau_maj.max()) : 1.0;
       double forced_tau = 0.0;
-      if (depth < options_.forced_collision_segments) {
+      if (forced) {
         // --- Forced first collision on the first segments of the path (the
         // camera ray, the ray after the first vertex).  Their tentative
         // collisions split into "none" (weight T_maj of the whole segment,
@@ -156,8 +160,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         // 1 - T_maj).  Both are followed, so these rays always gather the
         // sun in the air and scatter on, instead of about 1 time in 10 in a
         // clear noon sky: the main source of multiple-scattering noise.
-        const SampledSpectrum tau = majorant_optical_depth(medium, medium.fine_shells(), ray, extent.t_begin,
-                                                           extent.t_end, path.bins) * scale;
+        const SampledSpectrum tau = tau_maj * scale;
         PathState none = st;
         none.beta *= exp_neg(tau);
         none.r_l *= exp_neg(tau);

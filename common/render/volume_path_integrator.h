@@ -137,8 +137,8 @@ class VolumePathIntegrator {
   SampledSpectrum sunlit_single_scattering(const Ray& ray, double t0, double t1, const SampledWavelengths& lambda,
                                            const PathCoefficients& path, const PathPhases& phases, Sampler& sampler,
                                            PathCounters* counters) const;
-  double camera_majorant_scale(const Ray& ray, double t_begin, double t_end,
-                               const std::array<std::size_t, kWavelengthsPerPath>& bins) const;
+  // The camera ray's majorant inflation from its largest majorant optical depth.
+  double camera_majorant_scale(double tau) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
                              PathCounters* counters) const;
 
