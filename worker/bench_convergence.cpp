@@ -193,10 +193,14 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     else if (args[i] == "--scene" && i + 1 < args.size()) only = args[++i];
     else if (args[i] == "--forced-segments" && i + 1 < args.size())
       options.forced_collision_segments = std::atoi(args[++i].c_str());
+    else if (args[i] == "--plain-ratio-tracking")
+      options.residual_ratio_tracking = false;
+    else if (args[i] == "--sunlit-segments")
+      options.explicit_single_scattering = true;
     else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
-                   " [--forced-segments K]\n";
+                   " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n";
       return 2;
     }
   }

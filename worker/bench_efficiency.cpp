@@ -99,9 +99,14 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       breakdown = true;
     } else if (args[i] == "--sunlit-segments") {
       options.explicit_single_scattering = true;
+    } else if (args[i] == "--residual-below-cos" && i + 1 < args.size()) {
+      options.residual_tracking_below_cos = std::atof(args[++i].c_str());
+    } else if (args[i] == "--plain-ratio-tracking") {
+      options.residual_ratio_tracking = false;
     } else {
       std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
-                   "[--shadow-scale S] [--sunlit-segments]\n";
+                   "[--shadow-scale S] [--sunlit-segments] [--plain-ratio-tracking] [--max-depth N]\n"
+                   "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--breakdown]\n";
       return 2;
     }
   }
@@ -114,6 +119,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                                 {"samples_per_direction", samples},
                                 {"shadow_majorant_scale", options.shadow_majorant_scale},
                                 {"sunlit_segments", options.explicit_single_scattering},
+                                {"residual_ratio_tracking", options.residual_ratio_tracking},
                                 {"relative_std_per_path", r.relative_std_per_path},
                                 {"microseconds_per_path", r.microseconds_per_path},
                                 {"efficiency", rel2 > 0.0 ? 1.0 / (rel2 * r.microseconds_per_path) : 0.0},

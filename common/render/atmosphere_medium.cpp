@@ -1,5 +1,6 @@
 #include "common/render/atmosphere_medium.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -73,6 +74,52 @@ AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_m
     if (con.absorbs()) absorbers_.push_back(static_cast<int>(c));
   }
   if (any_ozone) temperature_ = UniformTable(0.0, top, n_h, us76::temperature_K);
+  build_control_shells();
+}
+
+double UniformTable::min_on(double a, double b) const {
+  double m = std::min(eval(a), eval(b));
+  const double last = static_cast<double>(v_.size() - 1);
+  const double u0 = std::max(0.0, std::ceil((a - x0_) * inv_step_)), u1 = std::min(last, std::floor((b - x0_) * inv_step_));
+  for (double u = u0; u <= u1; u += 1.0) m = std::min(m, v_[static_cast<std::size_t>(u)]);
+  return m;
+}
+
+// The control extinction of residual ratio tracking on the fine shells:
+//   sigma_c(shell, bin) = sum_c min_shell rho_c * (min_bin k_s,c + min_bin,columns k_a,c),
+// a lower bound of the tabulated sigma_t in the shell and bin (every factor
+// is >= 0 and linear between knots, so its minimum is at a knot or an end),
+// shaved by 1e-9 relative against round-off; the residual majorant is then
+// sigma_maj - sigma_c >= sigma_t - sigma_c >= 0.
+void AtmosphereMedium::build_control_shells() {
+  const std::size_t bins = fine_.bins, shells = fine_.shell_count();
+  control_.bins = residual_.bins = bins;
+  control_.bottoms = residual_.bottoms = fine_.bottoms;
+  control_.table.assign(shells * bins, 0.0);
+  for (const Tables& t : tables_) {
+    for (std::size_t i = 0; i < shells; ++i) {
+      const double rho_min = t.rho.min_on(fine_.bottoms[i], fine_.bottoms[i + 1]);
+      if (!(rho_min > 0.0)) continue;
+      for (std::size_t j = 0; j < bins; ++j) {
+        const double l0 = majorants_.lambda_min_nm() + majorants_.bin_width_nm() * static_cast<double>(j);
+        const double l1 = l0 + majorants_.bin_width_nm();
+        double k_min = t.k_s.min_on(l0, l1);
+        if (t.ozone) {
+          double k_a_min = t.k_a_columns[0].min_on(l0, l1);
+          for (const UniformTable& column : t.k_a_columns) k_a_min = std::min(k_a_min, column.min_on(l0, l1));
+          k_min += k_a_min;
+        } else {
+          k_min += t.k_a.min_on(l0, l1);
+        }
+        control_.table[i * bins + j] += rho_min * k_min;
+      }
+    }
+  }
+  residual_.table.resize(control_.table.size());
+  for (std::size_t n = 0; n < control_.table.size(); ++n) {
+    control_.table[n] = std::max(0.0, control_.table[n] * (1.0 - 1e-9));
+    residual_.table[n] = std::max(0.0, fine_.table[n] - control_.table[n]);
+  }
 }
 
 const std::string& AtmosphereMedium::scatterer_name(int s) const {

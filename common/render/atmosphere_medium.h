@@ -94,6 +94,9 @@ class UniformTable {
     u -= static_cast<double>(i);
     return v_[i] + u * (v_[i + 1] - v_[i]);
   }
+  // The smallest value on [a, b]: at the ends or at a knot in between (the
+  // function is linear between knots).
+  double min_on(double a, double b) const;
 
  private:
   double x0_ = 0.0, inv_step_ = 1.0;
@@ -112,6 +115,13 @@ class AtmosphereMedium {
   // costs a ray/sphere root.
   const ShellMajorants& fine_shells() const { return fine_; }
   const ShellMajorants& coarse_shells() const { return coarse_; }
+  // Residual ratio tracking of transmittance (residual_ratio_tracking.h):
+  // on the fine shells, a control extinction sigma_c per (shell, bin), a
+  // lower bound of sigma_t there (each constituent's smallest density in the
+  // shell times its smallest coefficient in the bin, ozone's over every
+  // temperature column), and the residual majorant sigma_maj - sigma_c.
+  const ShellMajorants& control_shells() const { return control_; }
+  const ShellMajorants& residual_shells() const { return residual_; }
   int scatterer_count() const { return static_cast<int>(scatterers_.size()); }
   const std::string& scatterer_name(int s) const;
   double altitude_step_m() const { return altitude_step_; }
@@ -125,6 +135,7 @@ class AtmosphereMedium {
 
  private:
   void build_shells();
+  void build_control_shells();
 
   struct Tables {
     UniformTable rho;                        // density on the altitude grid
@@ -136,7 +147,7 @@ class AtmosphereMedium {
   const Atmosphere& atmosphere_;
   double altitude_step_;
   MajorantGrid majorants_;
-  ShellMajorants fine_, coarse_;
+  ShellMajorants fine_, coarse_, control_, residual_;
   std::vector<Tables> tables_;   // per constituent
   UniformTable temperature_;     // US76 T(h), for ozone
   std::vector<int> scatterers_;  // constituent indices that scatter

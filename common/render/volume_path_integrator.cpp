@@ -9,6 +9,7 @@
 #include "common/core/math.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/free_flight.h"
+#include "common/render/residual_ratio_tracking.h"
 #include "common/sampling/warps.h"
 
 namespace skyfarm {
@@ -17,12 +18,6 @@ namespace {
 // Rays leaving the ground start this far above it, so a ray going up can
 // never meet the sphere it starts on (a convex surface), whatever the round-off.
 constexpr double kGroundOffset_m = 1e-6;
-
-SampledSpectrum clamp_zero(const SampledSpectrum& s) {
-  SampledSpectrum r;
-  for (int i = 0; i < kWavelengthsPerPath; ++i) r[i] = std::max(0.0, s[i]);
-  return r;
-}
 
 }  // namespace
 
@@ -358,7 +353,15 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (ground_distance(shadow, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
   const SphereHit top = intersect_sphere(shadow, atmosphere.top_radius_m());
   SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
-  if (top.hit && top.t_far > 0.0) {
+  if (top.hit && top.t_far > 0.0 && options_.residual_ratio_tracking &&
+      glm::dot(v.p, wi) < options_.residual_tracking_below_cos * glm::length(v.p)) {
+    const TrackedTransmittance tracked = residual_ratio_tracking(
+        scene_.medium(), shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, &counters->collisions, true);
+    if (tracked.T.is_zero()) return SampledSpectrum(0.0);
+    T_ray = tracked.T;
+    r_u_ray = tracked.r_u;
+    r_l_ray = tracked.r_l;
+  } else if (top.hit && top.t_far > 0.0) {
     const AtmosphereMedium& medium = scene_.medium();
     MediumPoint mp;
     const SampledSpectrum T_maj = sample_t_maj(
@@ -508,6 +511,10 @@ SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end
   if (!top.hit || top.t_far <= 0.0) return SampledSpectrum(1.0);
   const double t0 = std::max(0.0, top.t_near), t1 = std::min(t_end, top.t_far);
   if (t1 <= t0) return SampledSpectrum(1.0);
+  if (options_.residual_ratio_tracking)
+    return residual_ratio_tracking(medium, ray, t0, t1, medium.path_coefficients(lambda), sampler,
+                                   &counters->collisions, false)
+        .T;
   MediumPoint mp;
   SampledSpectrum T_ray(1.0);
   const SampledSpectrum T_maj = sample_t_maj(

@@ -56,6 +56,16 @@ struct IntegratorOptions {
   // with the sun at 85 deg and 1.57x at twilight (96 deg); 8 and 16 lose
   // again to the extra collisions.
   double shadow_majorant_scale = 4.0;
+  // Shadow rays and the sunlit-segment estimator's transmittances by residual
+  // ratio tracking against a per-shell control extinction
+  // (residual_ratio_tracking.h) instead of ratio tracking with the coarse
+  // majorants x shadow_majorant_scale (which then no longer applies).
+  bool residual_ratio_tracking = true;
+  // ... on shadow rays whose cosine to the local zenith is below this (air
+  // mass above ~3): on short shadow rays plain ratio tracking through the 9
+  // coarse shells is as good and cheaper than crossing ~40 fine shells
+  // (measured in docs/physics.md, "Efficiency").
+  double residual_tracking_below_cos = 0.35;
   // The sun's scattered light from a sunlit-segment estimator on every
   // segment of the path (camera ray and each ray after a vertex), sampled in
   // the lit part of the segment (see the .cpp), instead of NEE at tentative

@@ -66,6 +66,12 @@ struct SampledSpectrum {
     for (std::size_t i = 0; i < r.v.size(); ++i) r.v[i] = std::exp(-a.v[i]);
     return r;
   }
+  // max(0, a) per wavelength (null-collision coefficients against round-off).
+  friend SampledSpectrum clamp_zero(const SampledSpectrum& a) {
+    SampledSpectrum r;
+    for (std::size_t i = 0; i < r.v.size(); ++i) r.v[i] = std::max(0.0, a.v[i]);
+    return r;
+  }
 };
 
 }  // namespace skyfarm
