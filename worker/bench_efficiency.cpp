@@ -95,6 +95,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       options.forced_collision_segments = std::atoi(args[++i].c_str());
     } else if (args[i] == "--camera-collisions" && i + 1 < args.size()) {
       options.camera_target_collisions = std::atof(args[++i].c_str());
+    } else if (args[i] == "--rr-start-depth" && i + 1 < args.size()) {
+      options.rr_start_depth = std::atoi(args[++i].c_str());
     } else if (args[i] == "--breakdown") {
       breakdown = true;
     } else if (args[i] == "--sunlit-segments") {
@@ -106,7 +108,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
     } else {
       std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
                    "[--shadow-scale S] [--sunlit-segments] [--plain-ratio-tracking] [--max-depth N]\n"
-                   "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--breakdown]\n";
+                   "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D] [--breakdown]\n";
       return 2;
     }
   }

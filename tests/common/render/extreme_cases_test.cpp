@@ -108,7 +108,7 @@ TEST(ExtremeCases, AirHundredTimesDenserAndThinner) {
     expect_sane(r);
     const double collisions_per_path = static_cast<double>(r.counters.collisions) / static_cast<double>(r.counters.paths);
     RecordProperty("collisions_per_path_x" + std::to_string(static_cast<int>(factor * 100)), std::to_string(collisions_per_path));
-    EXPECT_LT(collisions_per_path, 2000.0) << "density x" << factor;  // measured: 252 at x100, 0.09 at x0.01
+    EXPECT_LT(collisions_per_path, 2000.0) << "density x" << factor;  // measured: 1217 at x100, 1.16 at x0.01
     EXPECT_GT(r.radiance[0][1], 0.0) << "density x" << factor;
   }
 }
