@@ -73,6 +73,29 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
           {"method", plan.lut ? "lut" : "path"}};
 }
 
+// A job's image at one moment, ready to be encoded and stored: dir/stem.exr|png.
+struct ImageSnapshot {
+  Image image;
+  fs::path dir;
+  std::string stem;
+  ExrWriteOptions exr;
+  PngWriteOptions png;
+};
+
+void write_snapshot(const ImageSnapshot& snap) {
+  try {
+    write_exr(snap.image, snap.dir / (snap.stem + ".exr"), snap.exr);
+    write_png(snap.image, snap.dir / (snap.stem + ".png"), snap.png);
+  } catch (const FileWriteError& e) {
+    throw StorageError(e.what());
+  }
+}
+
+void remove_preview(const fs::path& dir, int units) {
+  std::error_code ec;
+  for (const char* ext : {".exr", ".png"}) fs::remove(dir / ("preview-" + std::to_string(units) + ext), ec);
+}
+
 }  // namespace
 
 // --- One job in memory ------------------------------------------------------
@@ -95,6 +118,9 @@ struct Job {
   std::vector<JobEvent> events;
   std::string stopped_by;
   int preview_units = -1;
+  // Held while a preview is written outside the service's lock; guards preview_written.
+  std::mutex preview_writer;
+  int preview_written = -1;
   fs::path dir;
   std::vector<std::uint32_t> sun_pixels;  // left out of the error estimate
   std::string group;                      // shares out passes with its group (set_group)
@@ -154,6 +180,9 @@ struct JobService::Impl {
   nlohmann::json status_of(const Job& job) const;
   void finish_if_complete(Job& job);
   void write_images(Job& job, bool final);
+  // The images of a job's merged sums, resolved under the lock, and written
+  // (encoded and stored) by write_snapshot without it.
+  ImageSnapshot snapshot_images(Job& job, bool final);
   void requeue(std::uint64_t attempt, bool tell_worker);
   void fail_job(Job& job, const std::string& message);
   void drop_attempts_of(Job& job);
@@ -374,58 +403,86 @@ bool JobService::cancel(const std::string& id) {
 // Resolves the merged tiles into an image and writes EXR and PNG next to the
 // job's tiles: image.* when final, preview.* while running (atomic renames,
 // so readers of an older preview keep a complete file).
-void JobService::Impl::write_images(Job& job, bool final) {
+ImageSnapshot JobService::Impl::snapshot_images(Job& job, bool final) {
   const auto& out = job.request.output;
   ImageLayers layers;
   if (out.spectral_channels)
     layers.spectral = SpectralLayout{job.plan.lambda_min_nm, job.plan.lambda_max_nm, job.plan.batches};
   layers.relative_error = out.error_layer;
-  Image image(job.plan.width, job.plan.height, layers);
-  job.merger->resolve(&image);
-  // Previews are versioned by the units they hold, so a file and its ETag
-  // always agree; the previous one is removed (open readers keep its inode).
-  const std::string stem = final ? "image" : "preview-" + std::to_string(job.merger->merged_units());
+  ImageSnapshot snap{Image(job.plan.width, job.plan.height, layers), job.dir,
+                     final ? "image" : "preview-" + std::to_string(job.merger->merged_units()), {}, {}};
+  job.merger->resolve(&snap.image);
   const Sun sun = Sun::from_spec(job.request.sun, job.request.location, job.request.time);
-  api::set_render_metadata(&image, job.request, job.plan, sun,
+  api::set_render_metadata(&snap.image, job.request, job.plan, sun,
                            std::min(job.plan.samples_per_pixel,
                                     job.merger->complete_passes() * job.plan.samples_per_pass),
                            job.merger->error_sums(job.sun_pixels));
-  try {
-    ExrWriteOptions exr;
-    exr.half = out.half;
-    exr.spectral_channels = out.spectral_channels;
-    exr.error_layer = out.error_layer;
-    exr.latlong_envmap = job.request.camera.projection == Projection::kEquirectangular;
-    write_exr(image, job.dir / (stem + ".exr"), exr);
-    PngWriteOptions png;
-    png.exposure_ev = out.exposure_ev;
-    write_png(image, job.dir / (stem + ".png"), png);
-  } catch (const FileWriteError& e) {
-    throw StorageError(e.what());
-  }
-  if (job.preview_units >= 0 && job.preview_units != job.merger->merged_units()) {
-    std::error_code ec;
-    for (const char* ext : {".exr", ".png"})
-      fs::remove(job.dir / ("preview-" + std::to_string(job.preview_units) + ext), ec);
-  }
+  snap.exr.half = out.half;
+  snap.exr.spectral_channels = out.spectral_channels;
+  snap.exr.error_layer = out.error_layer;
+  snap.exr.latlong_envmap = job.request.camera.projection == Projection::kEquirectangular;
+  snap.png.exposure_ev = out.exposure_ev;
+  return snap;
 }
 
+// The final image (at finish and on resume), under the lock.
+void JobService::Impl::write_images(Job& job, bool final) {
+  write_snapshot(snapshot_images(job, final));
+  // Previews are versioned by the units they hold, so a file and its ETag
+  // always agree; the previous one is removed (open readers keep its inode).
+  if (job.preview_units >= 0 && job.preview_units != job.merger->merged_units())
+    remove_preview(job.dir, job.preview_units);
+}
+
+// A preview is resolved under the lock but encoded and written without it,
+// so a client fetching previews of a large image never holds up dispatch
+// and merging.  Concurrent fetches of the same version write the same bytes
+// once (one writer per job); a version overtaken by a newer one while it was
+// written is removed and the newer one served.
 std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat format) {
-  const std::lock_guard<std::mutex> lock(impl_->mu);
-  const auto it = impl_->jobs.find(id);
-  if (it == impl_->jobs.end()) return std::nullopt;
-  Job& job = *it->second;
   const char* ext = format == ImageFormat::kExr ? ".exr" : ".png";
-  if (job.record.state == "done") {
+  auto preview_file = [&](const Job& job) {
+    return ImageFile{job.dir / ("preview-" + std::to_string(job.preview_units) + ext),
+                     "\"" + job.record.id + "-" + std::to_string(job.preview_units) + "\"", false};
+  };
+  auto final_file = [&](const Job& job) {
     return ImageFile{job.dir / (std::string("image") + ext), "\"" + job.record.request_hash + "\"", true};
+  };
+  std::optional<ImageSnapshot> snap;
+  int units = 0;
+  Job* job = nullptr;
+  {
+    const std::lock_guard<std::mutex> lock(impl_->mu);
+    const auto it = impl_->jobs.find(id);
+    if (it == impl_->jobs.end()) return std::nullopt;
+    job = it->second.get();  // jobs are never erased: the pointer outlives the lock
+    if (job->record.state == "done") return final_file(*job);
+    if (!job->merger->first_pass_complete()) return std::nullopt;
+    units = job->merger->merged_units();
+    if (job->preview_units == units) return preview_file(*job);
+    snap = impl_->snapshot_images(*job, false);
   }
-  if (!job.merger->first_pass_complete()) return std::nullopt;
-  if (job.preview_units != job.merger->merged_units()) {
-    impl_->write_images(job, false);
-    job.preview_units = job.merger->merged_units();
+  {
+    // One writer per job at a time: two fetches of one version would share
+    // its temporary file name (AtomicFile); the second finds it written.
+    const std::lock_guard<std::mutex> writing(job->preview_writer);
+    if (job->preview_written != units) {
+      write_snapshot(*snap);
+      job->preview_written = units;
+    }
   }
-  return ImageFile{job.dir / ("preview-" + std::to_string(job.preview_units) + ext),
-                   "\"" + job.record.id + "-" + std::to_string(job.preview_units) + "\"", false};
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  if (job->record.state == "done") {  // finished meanwhile: the final image it is
+    remove_preview(job->dir, units);
+    return final_file(*job);
+  }
+  if (units > job->preview_units) {
+    if (job->preview_units >= 0) remove_preview(job->dir, job->preview_units);
+    job->preview_units = units;
+  } else if (units != job->preview_units) {
+    remove_preview(job->dir, units);  // overtaken by a newer preview
+  }
+  return preview_file(*job);
 }
 
 std::vector<JobEvent> JobService::events_after(const std::string& id, std::uint64_t after,

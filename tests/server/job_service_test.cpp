@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <thread>
+
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
@@ -247,6 +250,47 @@ TEST(JobService, PreviewAfterFirstPassWithChangingEtag) {
   ASSERT_TRUE(a);
   service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
   EXPECT_NE(service.image(id, ImageFormat::kPng)->etag, preview->etag);
+}
+
+// Previews are written outside the service's lock: clients fetching them
+// while every unit merges get a file that exists when they get it (or the
+// final image once done), versions never go back, and no overtaken preview
+// is left behind.
+TEST(JobService, ConcurrentPreviewFetchesDuringMergesLeaveOnlyTheFinalImage) {
+  const fs::path dir = fresh_dir("concurrent-previews");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  std::atomic<bool> done{false};
+  std::atomic<int> fetched{0}, problems{0};
+  std::vector<std::thread> clients;
+  for (int c = 0; c < 4; ++c) {
+    clients.emplace_back([&, c] {
+      std::string last_etag;
+      while (!done.load()) {
+        const auto file = service.image(id, c % 2 ? ImageFormat::kPng : ImageFormat::kExr);
+        if (!file) continue;
+        ++fetched;
+        if (file->final) return;
+        std::error_code ec;
+        if (!fs::exists(file->path, ec) && service.image(id, ImageFormat::kExr)->etag == file->etag) ++problems;
+        // "job-<units>": the version never goes back for one client.
+        const int units = std::stoi(file->etag.substr(file->etag.rfind('-') + 1));
+        if (!last_etag.empty() && units < std::stoi(last_etag.substr(last_etag.rfind('-') + 1))) ++problems;
+        last_etag = file->etag;
+      }
+    });
+  }
+  while (const auto a = service.next_unit("w")) service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+  ASSERT_EQ((*service.status(id))["state"], "done");
+  done = true;
+  for (auto& t : clients) t.join();
+  EXPECT_EQ(problems.load(), 0);
+  EXPECT_GT(fetched.load(), 0);
+  EXPECT_TRUE(service.image(id, ImageFormat::kExr)->final);
+  int previews = 0;
+  for (const auto& e : fs::directory_iterator(dir / "jobs" / id))
+    if (e.path().filename().string().rfind("preview-", 0) == 0) ++previews;
+  EXPECT_EQ(previews, 0);
 }
 
 TEST(JobService, UnwritableDataDirectoryIsAStorageError) {
