@@ -15,6 +15,7 @@
 #include <span>
 
 #include "common/geometry/ray.h"
+#include "common/geometry/sphere_intersection.h"
 
 namespace skyfarm {
 
@@ -31,6 +32,9 @@ class ShellTraversal {
   // the exit from the top, or any nearer distance.
   ShellTraversal(const Ray& ray, double planet_radius_m, std::span<const double> shell_bottoms, double t_begin,
                  double t_end);
+  // The same walk with the ray's radial constants already at hand (radial_ray(ray)).
+  ShellTraversal(const Ray& ray, const RadialRay& radial, double planet_radius_m, std::span<const double> shell_bottoms,
+                 double t_begin, double t_end);
 
   // The next segment; false when the walk is over.
   bool next(ShellSegment* segment);
