@@ -73,6 +73,7 @@ struct VolumePathIntegrator::Vertex {
   const MediumPoint* medium = nullptr;
   const PathPhases* phases = nullptr;
   const PathCoefficients* path = nullptr;
+  const PathMajorants* shadow_majorants = nullptr;  // the coarse shells' rows
   SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
 };
 
@@ -108,7 +109,9 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(const Ray& ray, const S
                                                          Sampler& sampler, PathCounters* counters) const {
   const PathCoefficients path = scene_.medium().path_coefficients(lambda, &scene_.sun());
   const PathPhases phases = scene_.medium().phases(lambda);
-  const PathContext c{lambda, path, phases, sampler, counters};
+  const PathMajorants fine(scene_.medium().fine_shells(), path.bins);
+  const PathMajorants coarse(scene_.medium().coarse_shells(), path.bins);
+  const PathContext c{lambda, path, fine, coarse, phases, sampler, counters};
   return trace(ray, PathState{}, 0, c);
 }
 
@@ -156,7 +159,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       if (depth == 0 || forced) {
         record.emplace(walk);
         RecordedShellWalk::Replay replay = record->replay();
-        tau_maj = majorant_optical_depth_along(replay, shells, path.bins);
+        tau_maj = majorant_optical_depth_along(replay, c.fine);
       }
       const double scale = depth == 0 ? camera_majorant_scale(tau_maj.max()) : 1.0;
       double forced_tau = 0.0;
@@ -197,7 +200,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
           const SampledSpectrum beta_s = st.beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
           const SampledSpectrum r_u_s = st.r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
           if (!beta_s.is_zero() && !r_u_s.is_zero()) {
-            Vertex v{p, ray.d, false, {}, &mp, &phases, &path, beta_s * p_scatter, r_u_s};
+            Vertex v{p, ray.d, false, {}, &mp, &phases, &path, &c.coarse, beta_s * p_scatter, r_u_s};
             L += sample_sun(v, c.lambda, sampler, counters);
           }
         }
@@ -232,7 +235,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         return !st.beta.is_zero() && !st.r_u.is_zero();
       };
       const auto fly = [&](auto& segments) {
-        return sample_t_maj_along(segments, medium, shells, ray, path, sampler, mp, collide, scale, forced_tau);
+        return sample_t_maj_along(segments, c.fine, medium, ray, path, sampler, mp, collide, scale, forced_tau);
       };
       SampledSpectrum T_maj;
       if (record) {
@@ -316,7 +319,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const Atmosphere& atmosphere = scene_.atmosphere();
   const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
   const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
-  Vertex v{p, ray->d, true, n, nullptr, nullptr, &path, st->beta, st->r_u};
+  Vertex v{p, ray->d, true, n, nullptr, nullptr, &path, &c.coarse, st->beta, st->r_u};
   if (scene_.sun_enabled) *L += sample_sun(v, c.lambda, c.sampler, c.counters);
   double pdf = 0.0;
   const glm::dvec3 wi = atmosphere.ground().sample_direction(n, c.sampler.next(), c.sampler.next(), &pdf);
@@ -386,7 +389,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     ShellTraversal walk(shadow, radial, atmosphere.planet_radius_m(), shells.bottoms, std::max(0.0, top.t_near),
                         top.t_far);
     const SampledSpectrum T_maj = sample_t_maj_along(
-        walk, medium, shells, shadow, *v.path, sampler, mp,
+        walk, *v.shadow_majorants, medium, shadow, *v.path, sampler, mp,
         [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
           ++counters->collisions;
           const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
