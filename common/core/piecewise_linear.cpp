@@ -19,6 +19,58 @@ PiecewiseLinear::PiecewiseLinear(std::vector<double> x, std::vector<double> y, O
     if (i > 0 && !(x_[i] > x_[i - 1]))
       throw std::invalid_argument(what + ": abscissae must increase strictly (index " + std::to_string(i) + ")");
   }
+  build_buckets();
+}
+
+void PiecewiseLinear::build_buckets() {
+  constexpr std::size_t kMinKnots = 16, kMaxBuckets = std::size_t{1} << 16;
+  const std::size_t n = x_.size();
+  if (n < kMinKnots) return;
+  std::vector<double> steps(n - 1);
+  for (std::size_t i = 0; i + 1 < n; ++i) steps[i] = x_[i + 1] - x_[i];
+  std::vector<double> sorted = steps;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  // The longest run of intervals no wider than 4 medians.
+  std::size_t best_lo = 0, best_hi = 0;
+  for (std::size_t lo = 0; lo < n - 1;) {
+    if (steps[lo] > 4.0 * median) {
+      ++lo;
+      continue;
+    }
+    std::size_t hi = lo;
+    while (hi < n - 1 && steps[hi] <= 4.0 * median) ++hi;
+    if (hi - lo > best_hi - best_lo) {
+      best_lo = lo;
+      best_hi = hi;
+    }
+    lo = hi;
+  }
+  if (best_hi - best_lo + 1 < kMinKnots) return;
+  window_lo_ = x_[best_lo];
+  window_hi_ = x_[best_hi];
+  const double width = window_hi_ - window_lo_;
+  const std::size_t buckets = std::min(kMaxBuckets, static_cast<std::size_t>(std::ceil(width / median)) + 1);
+  bucket_scale_ = static_cast<double>(buckets) / width;
+  bucket_knot_.resize(buckets);
+  for (std::size_t j = 0; j < buckets; ++j) {
+    const double edge = window_lo_ + static_cast<double>(j) / bucket_scale_;
+    const auto it = std::upper_bound(x_.begin(), x_.end(), edge);
+    bucket_knot_[j] = static_cast<std::uint32_t>(std::max<std::ptrdiff_t>(it - x_.begin() - 1, 0));
+  }
+}
+
+std::size_t PiecewiseLinear::first_knot_above(double x) const {
+  const std::size_t n = x_.size();
+  if (x >= window_lo_ && x < window_hi_ && !bucket_knot_.empty()) {
+    auto j = static_cast<std::size_t>((x - window_lo_) * bucket_scale_);
+    if (j >= bucket_knot_.size()) j = bucket_knot_.size() - 1;
+    std::size_t i = bucket_knot_[j];
+    while (i < n && x_[i] <= x) ++i;
+    // x_[i] > x by the loop; i is the first such knot when x_[i - 1] <= x.
+    if (i > 0 && i < n && x_[i - 1] <= x) return i;
+  }
+  return static_cast<std::size_t>(std::upper_bound(x_.begin(), x_.end(), x) - x_.begin());
 }
 
 PiecewiseLinear PiecewiseLinear::constant(double value) { return PiecewiseLinear({0.0}, {value}); }
@@ -28,8 +80,7 @@ double PiecewiseLinear::eval(double x) const {
   if (x <= x_.front()) return (x < x_.front() && outside_ == Outside::kZero) ? 0.0 : y_.front();
   if (x >= x_.back()) return (x > x_.back() && outside_ == Outside::kZero) ? 0.0 : y_.back();
   // First knot strictly greater than x: x lies in [x_[i-1], x_[i]).
-  const auto it = std::upper_bound(x_.begin(), x_.end(), x);
-  const std::size_t i = static_cast<std::size_t>(it - x_.begin());
+  const std::size_t i = first_knot_above(x);
   const double t = (x - x_[i - 1]) / (x_[i] - x_[i - 1]);
   return y_[i - 1] + t * (y_[i] - y_[i - 1]);
 }

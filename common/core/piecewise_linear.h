@@ -1,6 +1,7 @@
 // A tabulated function y(x), linear between knots: every spectrum (cross-
 // sections, albedo, irradiance) and every tabulated profile is one of these.
 #pragma once
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -38,9 +39,24 @@ class PiecewiseLinear {
  private:
   template <class Reduce>
   double extreme_on(double a, double b, Reduce reduce) const;
+  // The first knot strictly greater than x, for x_.front() < x < x_.back():
+  // what std::upper_bound gives, found from the bucket index when x falls in
+  // its window (the answer is checked, so it is always upper_bound's).
+  std::size_t first_knot_above(double x) const;
+  void build_buckets();
 
   std::vector<double> x_, y_;
   Outside outside_ = Outside::kClamp;
+  // Bucket index for eval(): uniform buckets over the longest run of knots
+  // spaced at most 4x the median spacing (AM0: 119.5-2500 nm at 1-2 nm,
+  // beyond which it thins out to 600 000 nm); bucket j starts at
+  // window_lo_ + j / bucket_scale_ and bucket_knot_[j] is the last knot at or
+  // before that.  Empty for tables too small to need it.  Path tracing
+  // evaluates tables (the CIE functions, the sun, the albedo) at random
+  // wavelengths for every path: a binary search there is 10 or 11
+  // unpredictable branches.
+  double window_lo_ = 0.0, window_hi_ = 0.0, bucket_scale_ = 0.0;
+  std::vector<std::uint32_t> bucket_knot_;
 };
 
 }  // namespace skyfarm

@@ -7,11 +7,20 @@
 
 namespace skyfarm {
 
-SphereHit intersect_sphere(const Ray& ray, double radius) {
-  const double r = glm::length(ray.o);
-  const double b = glm::dot(ray.o, ray.d);
-  // Closest approach of the line to the centre, and the discriminant b^2 - c.
-  const double l = glm::length(ray.o - b * ray.d);
+RadialRay radial_ray(const Ray& ray) {
+  RadialRay k;
+  k.r = glm::length(ray.o);
+  k.b = glm::dot(ray.o, ray.d);
+  // Closest approach of the line to the centre.
+  k.l = glm::length(ray.o - k.b * ray.d);
+  return k;
+}
+
+SphereHit intersect_sphere(const Ray& ray, double radius) { return intersect_sphere(radial_ray(ray), radius); }
+
+SphereHit intersect_sphere(const RadialRay& ray, double radius) {
+  const double r = ray.r, b = ray.b, l = ray.l;
+  // The discriminant b^2 - c.
   const double D = (radius - l) * (radius + l);
   if (D < 0.0) return {};
   const double c = (r - radius) * (r + radius);
@@ -37,8 +46,10 @@ double distance_to_sphere(const Ray& ray, double radius) {
   return -1.0;
 }
 
-double ground_distance(const Ray& ray, double radius) {
-  if (glm::length(ray.o) <= radius) return glm::dot(ray.o, ray.d) < 0.0 ? 0.0 : -1.0;
+double ground_distance(const Ray& ray, double radius) { return ground_distance(radial_ray(ray), radius); }
+
+double ground_distance(const RadialRay& ray, double radius) {
+  if (ray.r <= radius) return ray.b < 0.0 ? 0.0 : -1.0;
   const SphereHit h = intersect_sphere(ray, radius);
   return (h.hit && h.t_near >= 0.0) ? h.t_near : -1.0;
 }

@@ -18,6 +18,15 @@
 
 namespace skyfarm {
 
+// The ray's constants with respect to the centre, shared by every sphere
+// (ground, top, shell boundaries) it is tested against: r = |o|, b = o.d and
+// l = |o - b d|.  The functions below taking a RadialRay give the same bits
+// as those taking the Ray, without recomputing them.
+struct RadialRay {
+  double r = 0.0, b = 0.0, l = 0.0;
+};
+RadialRay radial_ray(const Ray& ray);
+
 struct SphereHit {
   bool hit = false;
   double t_near = 0.0;  // smaller root (may be < 0: behind the origin)
@@ -26,6 +35,7 @@ struct SphereHit {
 
 // Both intersections of the ray's line with the sphere of `radius`.
 SphereHit intersect_sphere(const Ray& ray, double radius);
+SphereHit intersect_sphere(const RadialRay& ray, double radius);
 
 // Distance along the ray to where it first enters the sphere's solid ball
 // from outside, or leaves it from inside: the smallest root > 0; returns a
@@ -38,6 +48,7 @@ double distance_to_sphere(const Ray& ray, double radius);
 // the ray never meets it.  A camera standing on the ground (altitude 0) thus
 // sees the ground at its feet instead of the far side of the planet.
 double ground_distance(const Ray& ray, double radius);
+double ground_distance(const RadialRay& ray, double radius);
 
 // Altitude of a point above a sphere of `radius`: |p| - radius.
 double altitude_above(const glm::dvec3& p, double radius);

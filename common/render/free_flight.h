@@ -23,30 +23,36 @@
 // (forced collisions, e.g. Mitsuba's "forced scattering" of camera rays).
 #pragma once
 #include <cmath>
+#include <utility>
 
 #include <glm/geometric.hpp>
 
 #include "common/render/atmosphere_medium.h"
+#include "common/render/path_majorants.h"
 #include "common/render/shell_traversal.h"
 #include "common/sampling/sampler.h"
 
 namespace skyfarm {
 
-template <class Callback>
-SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorants& shells, const Ray& ray,
-                             double t_begin, double t_end,
-                             const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
-                             Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
+//
+// sample_t_maj_along does the same along any walk of the ray's shell segments
+// (a ShellTraversal, or the replay of a RecordedShellWalk when the segments
+// were already walked for majorant_optical_depth), with the majorants of the
+// path's wavelengths from `majorants` (PathMajorants, or TableMajorants:
+// path_majorants.h).
+template <class Walk, class Majorants, class Callback>
+SampledSpectrum sample_t_maj_along(Walk& walk, const Majorants& majorants, const AtmosphereMedium& medium,
+                                   const Ray& ray, const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
+                                   Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision
   double tau_target = forced_tau > 0.0
                           // Kept a hair inside the walk so round-off cannot lose the collision.
                           ? std::min(-std::log1p(sampler.next() * std::expm1(-forced_tau)), forced_tau * (1.0 - 1e-12))
                           : -std::log1p(-sampler.next());
-  ShellTraversal walk(ray, R, shells.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum sigma_maj = shells.sigma_maj(segment.shell, path.bins) * majorant_scale;
+    const SampledSpectrum sigma_maj = majorants.sigma_maj(segment.shell) * majorant_scale;
     double t = segment.t0;
     while (true) {
       const double tau_rest = sigma_maj[0] * (segment.t1 - t);
@@ -68,16 +74,42 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorant
   return exp_neg(tau_maj);
 }
 
+template <class Callback>
+SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorants& shells, const Ray& ray,
+                             double t_begin, double t_end,
+                             const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
+                             Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
+  ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), shells.bottoms, t_begin, t_end);
+  return sample_t_maj_along(walk, TableMajorants{shells, path.bins}, medium, ray, path, sampler, point,
+                            std::forward<Callback>(callback), majorant_scale, forced_tau);
+}
+
 // The majorant optical depth of [t_begin, t_end] at each of the path's
 // wavelengths: the expected number of tentative collisions there.
+// Along any walk of shell segments, any majorants (see sample_t_maj_along).
+template <class Walk, class Majorants>
+SampledSpectrum majorant_optical_depth_along(Walk& walk, const Majorants& majorants) {
+  ShellSegment segment;
+  // tau += sigma_maj * (t1 - t0), element by element, summed in plain locals
+  // so that the compiler keeps them in registers (a SampledSpectrum return
+  // slot went through memory at every segment); the same operations in the
+  // same order.
+  double sum[kWavelengthsPerPath] = {};
+  while (walk.next(&segment)) {
+    const SampledSpectrum m = majorants.sigma_maj(segment.shell);
+    const double dt = segment.t1 - segment.t0;
+    for (int i = 0; i < kWavelengthsPerPath; ++i) sum[i] += m[i] * dt;
+  }
+  SampledSpectrum tau;
+  for (int i = 0; i < kWavelengthsPerPath; ++i) tau[i] = sum[i];
+  return tau;
+}
+
 inline SampledSpectrum majorant_optical_depth(const AtmosphereMedium& medium, const ShellMajorants& shells,
                                               const Ray& ray, double t_begin, double t_end,
                                               const std::array<std::size_t, kWavelengthsPerPath>& bins) {
   ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), shells.bottoms, t_begin, t_end);
-  ShellSegment segment;
-  SampledSpectrum tau(0.0);
-  while (walk.next(&segment)) tau += shells.sigma_maj(segment.shell, bins) * (segment.t1 - segment.t0);
-  return tau;
+  return majorant_optical_depth_along(walk, TableMajorants{shells, bins});
 }
 
 }  // namespace skyfarm

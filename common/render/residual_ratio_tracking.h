@@ -24,11 +24,14 @@
 // per wavelength, the pdf of the collision pattern had it been the hero over
 // the hero's pdf (spectral MIS, pbrt-v4 SampleLd); r_u = T before roulette.
 //
+//   radial     the ray's constants (radial_ray(ray)), shared with the caller's
+//              ground and top intersections
 //   roulette   Russian roulette (q = 0.75) once the MIS-weighted estimate
 //              T / avg(r_l + r_u) falls below 0.05 (shadow rays)
 #pragma once
 #include <glm/geometric.hpp>
 
+#include "common/geometry/sphere_intersection.h"
 #include "common/render/atmosphere_medium.h"
 #include "common/render/shell_traversal.h"
 #include "common/sampling/sampler.h"
@@ -39,8 +42,9 @@ struct TrackedTransmittance {
   SampledSpectrum T{1.0}, r_l{1.0}, r_u{1.0};
 };
 
-inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medium, const Ray& ray, double t_begin,
-                                                    double t_end, const PathCoefficients& path, Sampler& sampler,
+inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medium, const Ray& ray,
+                                                    const RadialRay& radial, double t_begin, double t_end,
+                                                    const PathCoefficients& path, Sampler& sampler,
                                                     std::uint64_t* collisions, bool roulette) {
   const ShellMajorants& residual = medium.residual_shells();
   const ShellMajorants& control = medium.control_shells();
@@ -49,7 +53,7 @@ inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medi
   SampledSpectrum tau_r(0.0), tau_c(0.0);  // since the last collision
   MediumPoint mp;
   double tau_target = -std::log1p(-sampler.next());
-  ShellTraversal walk(ray, R, residual.bottoms, t_begin, t_end);
+  ShellTraversal walk(ray, radial, R, residual.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
     const SampledSpectrum mu_r = residual.sigma_maj(segment.shell, path.bins);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <glm/geometric.hpp>
 
@@ -9,6 +10,7 @@
 #include "common/core/math.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/free_flight.h"
+#include "common/render/recorded_shell_walk.h"
 #include "common/render/residual_ratio_tracking.h"
 #include "common/sampling/warps.h"
 
@@ -31,7 +33,7 @@ struct VolumePathIntegrator::RayExtent {
 namespace {
 using RayExtent = VolumePathIntegrator::RayExtent;
 
-RayExtent ray_extent(const Ray& ray, const Atmosphere& atmosphere) {
+RayExtent ray_extent(const RadialRay& ray, const Atmosphere& atmosphere) {
   RayExtent e;
   const SphereHit top = intersect_sphere(ray, atmosphere.top_radius_m());
   const double t_ground = ground_distance(ray, atmosphere.planet_radius_m());
@@ -66,6 +68,7 @@ struct VolumePathIntegrator::Vertex {
   const MediumPoint* medium = nullptr;
   const PathPhases* phases = nullptr;
   const PathCoefficients* path = nullptr;
+  const PathMajorants* shadow_majorants = nullptr;  // the coarse shells' rows
   SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
 };
 
@@ -101,7 +104,9 @@ SampledSpectrum VolumePathIntegrator::radiance_unchecked(const Ray& ray, const S
                                                          Sampler& sampler, PathCounters* counters) const {
   const PathCoefficients path = scene_.medium().path_coefficients(lambda, &scene_.sun());
   const PathPhases phases = scene_.medium().phases(lambda);
-  const PathContext c{lambda, path, phases, sampler, counters};
+  const PathMajorants fine(scene_.medium().fine_shells(), path.bins);
+  const PathMajorants coarse(scene_.medium().coarse_shells(), path.bins);
+  const PathContext c{lambda, path, fine, coarse, phases, sampler, counters};
   return trace(ray, PathState{}, 0, c);
 }
 
@@ -125,7 +130,8 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
   MediumPoint mp;
 
   for (;; ++depth) {
-    const RayExtent extent = ray_extent(ray, atmosphere);
+    const RadialRay radial = radial_ray(ray);
+    const RayExtent extent = ray_extent(radial, atmosphere);
     bool scattered = false, absorbed = false;
     // --- The sun scattered once along this segment, sampled where it is lit.
     if (explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
@@ -137,11 +143,19 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
       // The segment's majorant optical depth, once, for the camera ray's
       // inflation and the forced collision.
+      // Those segments are walked twice (here and in the flight), so their
+      // shell crossings are recorded and replayed.
       const bool forced = depth < options_.forced_collision_segments;
-      const SampledSpectrum tau_maj =
-          depth == 0 || forced
-              ? majorant_optical_depth(medium, medium.fine_shells(), ray, extent.t_begin, extent.t_end, path.bins)
-              : SampledSpectrum(0.0);
+      const ShellMajorants& shells = medium.fine_shells();
+      const ShellTraversal walk(ray, radial, atmosphere.planet_radius_m(), shells.bottoms, extent.t_begin,
+                                extent.t_end);
+      std::optional<RecordedShellWalk> record;
+      SampledSpectrum tau_maj(0.0);
+      if (depth == 0 || forced) {
+        record.emplace(walk);
+        RecordedShellWalk::Replay replay = record->replay();
+        tau_maj = majorant_optical_depth_along(replay, c.fine);
+      }
       const double scale = depth == 0 ? camera_majorant_scale(tau_maj.max()) : 1.0;
       double forced_tau = 0.0;
       if (forced) {
@@ -169,54 +183,63 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         st.r_u *= safe_div(SampledSpectrum(p_some[0]), p_some);
         forced_tau = tau[0];
       }
-      const SampledSpectrum T_maj = sample_t_maj(
-          medium, medium.fine_shells(), ray, extent.t_begin, extent.t_end, path, sampler, mp,
-          [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
-            ++counters->collisions;
-            const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
-            const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
-            // The sun gathered here in expectation: P_s times the NEE of the
-            // real-scattering branch (throughput and r_u of that branch).
-            if (scene_.sun_enabled && p_scatter > 0.0 && !explicit_single) {
-              const double pdf = T_maj_seg[0] * mp.sigma_s[0];
-              const SampledSpectrum beta_s = st.beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              const SampledSpectrum r_u_s = st.r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              if (!beta_s.is_zero() && !r_u_s.is_zero()) {
-                Vertex v{p, ray.d, false, {}, &mp, &phases, &path, beta_s * p_scatter, r_u_s};
-                L += sample_sun(v, c.lambda, sampler, counters);
-              }
-            }
-            const double u = sampler.next();
-            if (u < p_absorb) {
-              absorbed = true;
-              return false;
-            }
-            if (u < p_absorb + p_scatter) {
-              // Real scattering: pdf of this event for the hero, T_maj sigma_s.
-              const double pdf = T_maj_seg[0] * mp.sigma_s[0];
-              st.beta *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              st.r_u *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
-              if (st.beta.is_zero() || st.r_u.is_zero()) {
-                absorbed = true;
-                return false;
-              }
-              scattered = scatter_in_medium(p, mp, phases, sampler, &ray, &st);
-              absorbed = !scattered;
-              return false;
-            }
-            // Null collision.
-            const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
-            const double pdf = T_maj_seg[0] * sigma_n[0];
-            if (!(pdf > 0.0)) {
-              st.beta = SampledSpectrum(0.0);
-              return false;
-            }
-            st.beta *= T_maj_seg * sigma_n * (1.0 / pdf);
-            st.r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
-            st.r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
-            return !st.beta.is_zero() && !st.r_u.is_zero();
-          },
-          scale, forced_tau);
+      const auto collide = [&](double, const glm::dvec3& p, const SampledSpectrum& sigma_maj,
+                           const SampledSpectrum& T_maj_seg) {
+        ++counters->collisions;
+        const double p_absorb = mp.sigma_a[0] / sigma_maj[0];
+        const double p_scatter = mp.sigma_s[0] / sigma_maj[0];
+        // The sun gathered here in expectation: P_s times the NEE of the
+        // real-scattering branch (throughput and r_u of that branch).
+        if (scene_.sun_enabled && p_scatter > 0.0 && !explicit_single) {
+          const double pdf = T_maj_seg[0] * mp.sigma_s[0];
+          const SampledSpectrum beta_s = st.beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+          const SampledSpectrum r_u_s = st.r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
+          if (!beta_s.is_zero() && !r_u_s.is_zero()) {
+            Vertex v{p, ray.d, false, {}, &mp, &phases, &path, &c.coarse, beta_s * p_scatter, r_u_s};
+            L += sample_sun(v, c.lambda, sampler, counters);
+          }
+        }
+        const double u = sampler.next();
+        if (u < p_absorb) {
+          absorbed = true;
+          return false;
+        }
+        if (u < p_absorb + p_scatter) {
+          // Real scattering: pdf of this event for the hero, T_maj sigma_s.
+          const double pdf = T_maj_seg[0] * mp.sigma_s[0];
+          st.beta *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+          st.r_u *= T_maj_seg * mp.sigma_s * (1.0 / pdf);
+          if (st.beta.is_zero() || st.r_u.is_zero()) {
+            absorbed = true;
+            return false;
+          }
+          scattered = scatter_in_medium(p, mp, phases, sampler, &ray, &st);
+          absorbed = !scattered;
+          return false;
+        }
+        // Null collision.
+        const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+        const double pdf = T_maj_seg[0] * sigma_n[0];
+        if (!(pdf > 0.0)) {
+          st.beta = SampledSpectrum(0.0);
+          return false;
+        }
+        st.beta *= T_maj_seg * sigma_n * (1.0 / pdf);
+        st.r_u *= T_maj_seg * sigma_n * (1.0 / pdf);
+        st.r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
+        return !st.beta.is_zero() && !st.r_u.is_zero();
+      };
+      const auto fly = [&](auto& segments) {
+        return sample_t_maj_along(segments, c.fine, medium, ray, path, sampler, mp, collide, scale, forced_tau);
+      };
+      SampledSpectrum T_maj;
+      if (record) {
+        RecordedShellWalk::Replay replay = record->replay();
+        T_maj = fly(replay);
+      } else {
+        ShellTraversal live = walk;
+        T_maj = fly(live);
+      }
       if (absorbed || st.beta.is_zero()) return L;
       if (!scattered) {
         const double T0 = T_maj[0];
@@ -291,7 +314,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const Atmosphere& atmosphere = scene_.atmosphere();
   const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
   const glm::dvec3 p = n * (atmosphere.planet_radius_m() + kGroundOffset_m);
-  Vertex v{p, ray->d, true, n, nullptr, nullptr, &path, st->beta, st->r_u};
+  Vertex v{p, ray->d, true, n, nullptr, nullptr, &path, &c.coarse, st->beta, st->r_u};
   if (scene_.sun_enabled) *L += sample_sun(v, c.lambda, c.sampler, c.counters);
   double pdf = 0.0;
   const glm::dvec3 wi = atmosphere.ground().sample_direction(n, c.sampler.next(), c.sampler.next(), &pdf);
@@ -350,22 +373,27 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
 
   // Shadow ray: blocked by the planet, else ratio tracking to the top.
   const Ray shadow{v.p, wi};
-  if (ground_distance(shadow, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
-  const SphereHit top = intersect_sphere(shadow, atmosphere.top_radius_m());
+  const RadialRay radial = radial_ray(shadow);  // shared by the ground, the top and the shells
+  if (ground_distance(radial, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
+  const SphereHit top = intersect_sphere(radial, atmosphere.top_radius_m());
   SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
   if (top.hit && top.t_far > 0.0 && options_.residual_ratio_tracking &&
       glm::dot(v.p, wi) < options_.residual_tracking_below_cos * glm::length(v.p)) {
-    const TrackedTransmittance tracked = residual_ratio_tracking(
-        scene_.medium(), shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, &counters->collisions, true);
+    const TrackedTransmittance tracked =
+        residual_ratio_tracking(scene_.medium(), shadow, radial, std::max(0.0, top.t_near), top.t_far, *v.path,
+                                sampler, &counters->collisions, true);
     if (tracked.T.is_zero()) return SampledSpectrum(0.0);
     T_ray = tracked.T;
     r_u_ray = tracked.r_u;
     r_l_ray = tracked.r_l;
   } else if (top.hit && top.t_far > 0.0) {
     const AtmosphereMedium& medium = scene_.medium();
+    const ShellMajorants& shells = medium.coarse_shells();
     MediumPoint mp;
-    const SampledSpectrum T_maj = sample_t_maj(
-        medium, medium.coarse_shells(), shadow, std::max(0.0, top.t_near), top.t_far, *v.path, sampler, mp,
+    ShellTraversal walk(shadow, radial, atmosphere.planet_radius_m(), shells.bottoms, std::max(0.0, top.t_near),
+                        top.t_far);
+    const SampledSpectrum T_maj = sample_t_maj_along(
+        walk, *v.shadow_majorants, medium, shadow, *v.path, sampler, mp,
         [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
           ++counters->collisions;
           const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
@@ -512,7 +540,7 @@ SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end
   const double t0 = std::max(0.0, top.t_near), t1 = std::min(t_end, top.t_far);
   if (t1 <= t0) return SampledSpectrum(1.0);
   if (options_.residual_ratio_tracking)
-    return residual_ratio_tracking(medium, ray, t0, t1, medium.path_coefficients(lambda), sampler,
+    return residual_ratio_tracking(medium, ray, radial_ray(ray), t0, t1, medium.path_coefficients(lambda), sampler,
                                    &counters->collisions, false)
         .T;
   MediumPoint mp;

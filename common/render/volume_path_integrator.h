@@ -40,6 +40,8 @@
 
 namespace skyfarm {
 
+class PathMajorants;
+
 struct IntegratorOptions {
   int max_depth = 10000;
   int rr_start_depth = 2;
@@ -130,6 +132,8 @@ class VolumePathIntegrator {
   struct PathContext {
     const SampledWavelengths& lambda;
     const PathCoefficients& path;
+    const PathMajorants& fine;    // the path's rows of the medium's fine shells (segments)
+    const PathMajorants& coarse;  // and of its coarse shells (shadow rays)
     const PathPhases& phases;
     Sampler& sampler;
     PathCounters* counters;

@@ -79,7 +79,12 @@ double uniform_cone_solid_angle(double theta_max) { return 4.0 * kPi * sqr(std::
 //   phi = 2 pi u.y,  pdf = 1 / Omega = 1 / (2 pi h).
 // (pbrt-v4 SampleUniformCone; Mitsuba warp::square_to_uniform_cone.)
 glm::dvec3 square_to_uniform_cone(const glm::dvec2& u, double theta_max) {
-  const double h = 2.0 * sqr(std::sin(0.5 * theta_max));
+  return square_to_uniform_cone_of_height(u, uniform_cone_height(theta_max));
+}
+
+double uniform_cone_height(double theta_max) { return 2.0 * sqr(std::sin(0.5 * theta_max)); }
+
+glm::dvec3 square_to_uniform_cone_of_height(const glm::dvec2& u, double h) {
   const double one_minus_cos = u.x * h;
   const double cos_theta = 1.0 - one_minus_cos;
   const double sin_theta = safe_sqrt(one_minus_cos * (2.0 - one_minus_cos));

@@ -47,6 +47,10 @@ double square_to_cosine_hemisphere_pdf(const glm::dvec3& w);
 // Solid angle of the cone, 4 pi sin^2(theta_max / 2) sr.
 double uniform_cone_solid_angle(double theta_max);
 glm::dvec3 square_to_uniform_cone(const glm::dvec2& u, double theta_max);
+// The same cone given by h = 1 - cos(theta_max) = uniform_cone_height(theta_max),
+// for callers that sample one cone many times (the sun disk): no sine per sample.
+double uniform_cone_height(double theta_max);
+glm::dvec3 square_to_uniform_cone_of_height(const glm::dvec2& u, double h);
 // 1 / solid angle inside the cone (angle to +z <= theta_max), 0 outside.
 double square_to_uniform_cone_pdf(const glm::dvec3& w, double theta_max);
 

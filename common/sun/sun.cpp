@@ -21,6 +21,13 @@ Sun::Sun(double zenith_deg, double azimuth_deg, double angular_radius_deg, Piece
       irradiance_(std::move(irradiance)) {
   if (!(angular_radius_deg >= 0.0) || angular_radius_deg >= 90.0)
     throw std::invalid_argument("sun: angular radius must be in [0, 90) degrees");
+  // Each as the expression it replaces computed it, so the values are the same bits.
+  const double s = std::sin(alpha_);
+  pi_sin2_alpha_ = kPi * s * s;
+  const double half = std::sin(0.5 * alpha_);
+  contains_bound_ = 2.0 * half * half;
+  solid_angle_ = uniform_cone_solid_angle(alpha_);
+  cone_height_ = uniform_cone_height(alpha_);
 }
 
 Sun Sun::from_spec(const SunSpec& spec, const Location& where, const std::optional<UtcInstant>& time) {
@@ -53,13 +60,12 @@ Sun Sun::from_spec(const SunSpec& spec, const Location& where, const std::option
   return sun;
 }
 
-double Sun::solid_angle_sr() const { return uniform_cone_solid_angle(alpha_); }
+double Sun::solid_angle_sr() const { return solid_angle_; }
 
 // L = E / (pi sin^2 alpha): see the header.
 double Sun::radiance(double lambda_nm) const {
   if (is_point()) return irradiance(lambda_nm);
-  const double s = std::sin(alpha_);
-  return irradiance(lambda_nm) / (kPi * s * s);
+  return irradiance(lambda_nm) / pi_sin2_alpha_;
 }
 
 // cos(angle to the centre) >= cos(alpha), compared as 1 - cos to keep
@@ -68,8 +74,7 @@ bool Sun::contains(const glm::dvec3& w) const {
   if (is_point()) return false;
   const glm::dvec3 diff = w - direction_;
   const double one_minus_cos = 0.5 * glm::dot(diff, diff);
-  const double half = std::sin(0.5 * alpha_);
-  return one_minus_cos <= 2.0 * half * half;
+  return one_minus_cos <= contains_bound_;
 }
 
 glm::dvec3 Sun::sample_direction(double u1, double u2, double* pdf) const {
@@ -78,7 +83,7 @@ glm::dvec3 Sun::sample_direction(double u1, double u2, double* pdf) const {
     return direction_;
   }
   *pdf = 1.0 / solid_angle_sr();
-  return glm::normalize(frame_.to_world(square_to_uniform_cone({u1, u2}, alpha_)));
+  return glm::normalize(frame_.to_world(square_to_uniform_cone_of_height({u1, u2}, cone_height_)));
 }
 
 double Sun::pdf(const glm::dvec3& w) const { return contains(w) ? 1.0 / solid_angle_sr() : 0.0; }

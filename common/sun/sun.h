@@ -56,6 +56,14 @@ class Sun {
   double zenith_deg_, azimuth_deg_, distance_au_ = 1.0;
   double alpha_;
   double cos_alpha_;
+  // Constants of the disk, computed once (each costs a sine, and the path
+  // tracer asks for them at every sun sample): pi sin^2(alpha) of the
+  // radiance, the bound on 1 - cos of contains(), the solid angle, and the
+  // cone height 1 - cos(alpha) of sample_direction().
+  double pi_sin2_alpha_;
+  double contains_bound_;
+  double solid_angle_;
+  double cone_height_;
   glm::dvec3 direction_;
   Frame frame_;
   PiecewiseLinear irradiance_;
