@@ -195,12 +195,15 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       options.forced_collision_segments = std::atoi(args[++i].c_str());
     else if (args[i] == "--plain-ratio-tracking")
       options.residual_ratio_tracking = false;
+    else if (args[i] == "--no-sunlit-in-shadow")
+      options.sunlit_segments_in_shadow = false;
     else if (args[i] == "--sunlit-segments")
       options.explicit_single_scattering = true;
     else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
-                   " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n";
+                   " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
+                   "  [--no-sunlit-in-shadow]\n";
       return 2;
     }
   }

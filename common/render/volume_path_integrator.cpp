@@ -12,6 +12,7 @@
 #include "common/render/free_flight.h"
 #include "common/render/recorded_shell_walk.h"
 #include "common/render/residual_ratio_tracking.h"
+#include "common/render/sunlit_intervals.h"
 #include "common/sampling/warps.h"
 
 namespace skyfarm {
@@ -126,18 +127,27 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
   // gathers no sun at its medium vertices and does not count the sun disk
   // seen right after one (that light is the segment estimator's).  Ground
   // vertices keep their NEE with MIS.
-  const bool explicit_single = options_.explicit_single_scattering && scene_.sun_enabled;
   MediumPoint mp;
 
   for (;; ++depth) {
     const RadialRay radial = radial_ray(ray);
     const RayExtent extent = ray_extent(radial, atmosphere);
     bool scattered = false, absorbed = false;
-    // --- The sun scattered once along this segment, sampled where it is lit.
-    if (explicit_single && extent.in_atmosphere && extent.t_end > extent.t_begin)
-      L += st.beta *
-           sunlit_single_scattering(ray, extent.t_begin, extent.t_end, c.lambda, path, phases, sampler, counters) *
-           (1.0 / st.r_u.average());
+    // --- The sun scattered once along this segment, sampled where it is lit:
+    // on segments the planet's shadow cuts or that start with the sun below
+    // their local horizontal (or on every one if asked).
+    bool explicit_single = false;
+    if (scene_.sun_enabled && extent.in_atmosphere && extent.t_end > extent.t_begin &&
+        (options_.explicit_single_scattering || options_.sunlit_segments_in_shadow)) {
+      const SunlitIntervals lit = sunlit_intervals(ray, extent.t_begin, extent.t_end, scene_.sun().direction(),
+                                                   atmosphere.planet_radius_m());
+      explicit_single = options_.explicit_single_scattering || lit.shadowed ||
+                        glm::dot(ray.o, scene_.sun().direction()) < 0.0;
+      if (explicit_single) {
+        const SunlitSample ss = sunlit_single_scattering(ray, lit, path, phases, sampler, counters);
+        if (!ss.L.is_zero()) L += st.beta * ss.L * (1.0 / (st.r_u * ss.r).average());
+      }
+    }
 
     // --- Through the medium: delta tracking with spectral MIS.
     if (extent.in_atmosphere && extent.t_end > extent.t_begin) {
@@ -253,7 +263,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       continue;
     }
     st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
-    st.last_vertex_in_medium = true;
+    st.sun_from_segment_estimator = explicit_single;
     if (!survives(&st, depth, sampler, counters)) return L;
   }
 }
@@ -296,7 +306,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const PathCoefficients& path = c.path;
   if (st->beta.is_zero()) return false;
   if (!extent.hits_ground) {
-    const bool sun_is_segment_estimators = options_.explicit_single_scattering && st->last_vertex_in_medium;
+    const bool sun_is_segment_estimators = st->sun_from_segment_estimator;
     if (scene_.sun_enabled && sun.contains(ray->d) && !sun_is_segment_estimators) {
       const SampledSpectrum& Le = path.sun_radiance;
       if (!st->mis_with_sun) {
@@ -323,7 +333,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->beta *= path.ground_albedo;
   st->r_l = st->r_u * (1.0 / pdf);
   st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
-  st->last_vertex_in_medium = false;
+  st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
   return survives(st, depth, c.sampler, c.counters);
 }
@@ -441,121 +451,114 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
 // are unbiased ratio-tracking estimates, the sun direction is sampled on the
 // disk.  When the sun is below the horizon this puts every sample where the
 // light is, instead of waiting for a rare collision high up.
-SampledSpectrum VolumePathIntegrator::sunlit_single_scattering(const Ray& ray, double t0, double t1,
-                                                               const SampledWavelengths& lambda,
-                                                               const PathCoefficients& path, const PathPhases& phases,
-                                                               Sampler& sampler, PathCounters* counters) const {
+VolumePathIntegrator::SunlitSample VolumePathIntegrator::sunlit_single_scattering(
+    const Ray& ray, const SunlitIntervals& lit_parts, const PathCoefficients& path, const PathPhases& phases,
+    Sampler& sampler, PathCounters* counters) const {
+  const auto& lit = lit_parts.lit;
+  const int n_lit = lit_parts.count;
+  SunlitSample none;
+  none.L = SampledSpectrum(0.0);
   const AtmosphereMedium& medium = scene_.medium();
   const double R = scene_.atmosphere().planet_radius_m();
-  const glm::dvec3 s = scene_.sun().direction();
-  // Shadow cylinder: perp^2(t) = A t^2 + 2 B t + C' with C' = |o|^2 - (o.s)^2; inside when < R^2.
-  const double os = glm::dot(ray.o, s), ds = glm::dot(ray.d, s);
-  const double A = 1.0 - ds * ds, B = glm::dot(ray.o, ray.d) - os * ds;
-  const double C = (glm::dot(ray.o, ray.o) - os * os) - R * R;
-  double c0 = 1.0, c1 = 0.0;  // inside-cylinder interval (empty if c0 > c1)
-  if (A > 1e-12) {
-    const double disc = B * B - A * C;
-    if (disc > 0.0) {
-      const double root = std::sqrt(disc);
-      c0 = (-B - root) / A;
-      c1 = (-B + root) / A;
-    }
-  } else if (C < 0.0) {
-    c0 = -1e300;
-    c1 = 1e300;
-  }
-  // Behind the planet: x.s < 0, i.e. os + t ds < 0.
-  double h0 = -1e300, h1 = 1e300;
-  if (ds > 0.0) h1 = -os / ds;
-  else if (ds < 0.0) h0 = -os / ds;
-  else if (os >= 0.0) {  // never behind the planet: an empty half-space
-    h0 = 1.0;
-    h1 = 0.0;
-  }
-  const double shadow0 = std::max(c0, h0), shadow1 = std::min(c1, h1);
-  std::array<std::pair<double, double>, 2> lit{};
-  int n_lit = 0;
-  if (!(shadow0 < shadow1) || shadow1 <= t0 || shadow0 >= t1) {
-    lit[n_lit++] = {t0, t1};
-  } else {
-    if (shadow0 > t0) lit[n_lit++] = {t0, shadow0};
-    if (shadow1 < t1) lit[n_lit++] = {shadow1, t1};
-  }
-  // The hero's majorant optical depth of the sunlit intervals.
+  // The hero's majorant optical depth of the sunlit intervals, their shell
+  // walks recorded for the inversion below.
   const ShellMajorants& shells = medium.fine_shells();
-  double tau_lit = 0.0;
+  std::array<std::optional<RecordedShellWalk>, 2> walks;
+  SampledSpectrum tau_lit(0.0);  // at every wavelength, for the spectral-MIS pdfs
   for (int k = 0; k < n_lit; ++k) {
-    ShellTraversal walk(ray, R, shells.bottoms, lit[static_cast<std::size_t>(k)].first,
-                        lit[static_cast<std::size_t>(k)].second);
+    const auto [a, b] = lit[static_cast<std::size_t>(k)];
+    walks[static_cast<std::size_t>(k)].emplace(ShellTraversal(ray, R, shells.bottoms, a, b));
+    auto walk = walks[static_cast<std::size_t>(k)]->replay();
     ShellSegment seg;
-    while (walk.next(&seg)) tau_lit += shells.sigma_maj(seg.shell, path.bins)[0] * (seg.t1 - seg.t0);
+    while (walk.next(&seg)) tau_lit += shells.sigma_maj(seg.shell, path.bins) * (seg.t1 - seg.t0);
   }
   const double u_t = sampler.next(), u_s1 = sampler.next(), u_s2 = sampler.next();
-  if (!(tau_lit > 0.0)) return SampledSpectrum(0.0);
+  if (!(tau_lit[0] > 0.0)) return none;
   // Invert: the point where the majorant optical depth reaches tau_star,
   // drawn from the truncated exponential p(tau) = e^-tau / (1 - e^-tau_lit)
   // so that long, dense lit segments (the horizon at noon) sample near the
   // camera, where T(o, x_t) keeps the light, and thin ones (twilight) almost
   // uniformly in tau, i.e. where the lit air is densest.
-  const double lit_mass = -std::expm1(-tau_lit);
-  const double tau_star = std::min(tau_lit, -std::log1p(-u_t * lit_mass));
-  double target = tau_star, t = -1.0, sigma_maj0 = 0.0;
+  const double lit_mass = -std::expm1(-tau_lit[0]);
+  const double tau_star = std::min(tau_lit[0], -std::log1p(-u_t * lit_mass));
+  double target = tau_star, t = -1.0;
+  SampledSpectrum sigma_maj_t(0.0), tau_t(0.0);  // at t, and the lit optical depth up to t
   for (int k = 0; k < n_lit && t < 0.0; ++k) {
-    ShellTraversal walk(ray, R, shells.bottoms, lit[static_cast<std::size_t>(k)].first,
-                        lit[static_cast<std::size_t>(k)].second);
+    auto walk = walks[static_cast<std::size_t>(k)]->replay();
     ShellSegment seg;
     while (walk.next(&seg)) {
-      const double m = shells.sigma_maj(seg.shell, path.bins)[0];
-      const double tau_seg = m * (seg.t1 - seg.t0);
-      if (m > 0.0 && target <= tau_seg) {
-        t = seg.t0 + target / m;
-        sigma_maj0 = m;
+      const SampledSpectrum m = shells.sigma_maj(seg.shell, path.bins);
+      const double tau_seg = m[0] * (seg.t1 - seg.t0);
+      if (m[0] > 0.0 && target <= tau_seg) {
+        t = seg.t0 + target / m[0];
+        sigma_maj_t = m;
+        tau_t += m * (t - seg.t0);
         break;
       }
       target -= tau_seg;
+      tau_t += m * (seg.t1 - seg.t0);
     }
   }
-  if (t < 0.0 || !(sigma_maj0 > 0.0)) return SampledSpectrum(0.0);
-  const double pdf_t = sigma_maj0 * std::exp(-tau_star) / lit_mass;
+  if (t < 0.0 || !(sigma_maj_t[0] > 0.0)) return none;
+  // pdf of t had each wavelength been the hero (truncated exponential of its
+  // own majorant); the hero's is the estimator's.
+  SampledSpectrum pdf_t_all;
+  for (int i = 0; i < kWavelengthsPerPath; ++i)
+    pdf_t_all[i] = sigma_maj_t[i] * std::exp(-tau_t[i]) / -std::expm1(-tau_lit[i]);
+  const double pdf_t = pdf_t_all[0];
   const glm::dvec3 x = ray.at(t);
   MediumPoint mp;
   medium.point(glm::length(x) - R, path, &mp);
-  if (mp.sigma_s.is_zero()) return SampledSpectrum(0.0);
+  if (mp.sigma_s.is_zero()) return none;
   // The sun: a direction on the disk, blocked by the planet or not.
   double pdf_light = 0.0;
   const glm::dvec3 wi = scene_.sun().sample_direction(u_s1, u_s2, &pdf_light);
   const Ray to_sun{x, wi};
-  if (ground_distance(to_sun, R) >= 0.0) return SampledSpectrum(0.0);
+  if (ground_distance(to_sun, R) >= 0.0) return none;
   const SampledSpectrum p = mixture_phase(mp, phases, clamp_cos(glm::dot(ray.d, wi)));
-  const SampledSpectrum T_cam = transmittance(ray, t, lambda, sampler, counters);
-  const SampledSpectrum T_sun = transmittance(to_sun, 1e300, lambda, sampler, counters);
-  return T_cam * mp.sigma_s * p * T_sun * path.sun_radiance * (1.0 / (pdf_t * pdf_light));
+  const TrackedTransmittance T_cam = tracked_transmittance(ray, t, path, sampler, counters);
+  const TrackedTransmittance T_sun = tracked_transmittance(to_sun, 1e300, path, sampler, counters);
+  SunlitSample out;
+  out.L = T_cam.T * mp.sigma_s * p * T_sun.T * path.sun_radiance * (1.0 / (pdf_t * pdf_light));
+  out.r = pdf_t_all * (1.0 / pdf_t) * T_cam.r_l * T_sun.r_l;
+  return out;
 }
 
 SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda,
                                                     Sampler& sampler, PathCounters* counters) const {
+  return tracked_transmittance(ray, t_end, scene_.medium().path_coefficients(lambda), sampler, counters).T;
+}
+
+TrackedTransmittance VolumePathIntegrator::tracked_transmittance(const Ray& ray, double t_end,
+                                                                 const PathCoefficients& path, Sampler& sampler,
+                                                                 PathCounters* counters) const {
   const AtmosphereMedium& medium = scene_.medium();
-  const SphereHit top = intersect_sphere(ray, scene_.atmosphere().top_radius_m());
-  if (!top.hit || top.t_far <= 0.0) return SampledSpectrum(1.0);
+  const RadialRay radial = radial_ray(ray);
+  const SphereHit top = intersect_sphere(radial, scene_.atmosphere().top_radius_m());
+  if (!top.hit || top.t_far <= 0.0) return {};
   const double t0 = std::max(0.0, top.t_near), t1 = std::min(t_end, top.t_far);
-  if (t1 <= t0) return SampledSpectrum(1.0);
+  if (t1 <= t0) return {};
   if (options_.residual_ratio_tracking)
-    return residual_ratio_tracking(medium, ray, radial_ray(ray), t0, t1, medium.path_coefficients(lambda), sampler,
-                                   &counters->collisions, false)
-        .T;
+    return residual_ratio_tracking(medium, ray, radial, t0, t1, path, sampler, &counters->collisions, false);
+  // Ratio tracking: T *= sigma_n / sigma_maj (hero), times the other
+  // wavelengths' majorant-transmittance ratios; r_l the pattern's pdf had
+  // each wavelength been the hero, over the hero's.
   MediumPoint mp;
-  SampledSpectrum T_ray(1.0);
+  TrackedTransmittance out;
   const SampledSpectrum T_maj = sample_t_maj(
-      medium, medium.coarse_shells(), ray, t0, t1, medium.path_coefficients(lambda), sampler, mp,
+      medium, medium.coarse_shells(), ray, t0, t1, path, sampler, mp,
       [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
         ++counters->collisions;
-        // Ratio tracking: T *= sigma_n / sigma_maj (hero), times the other
-        // wavelengths' majorant-transmittance ratios.
         const SampledSpectrum sigma_n = sigma_maj - mp.sigma_a - mp.sigma_s;
-        T_ray *= T_maj_seg * sigma_n * (1.0 / (T_maj_seg[0] * sigma_maj[0]));
+        const double pdf = T_maj_seg[0] * sigma_maj[0];
+        out.T *= T_maj_seg * sigma_n * (1.0 / pdf);
+        out.r_l *= T_maj_seg * sigma_maj * (1.0 / pdf);
         return true;
       });
-  return T_ray * T_maj * (1.0 / T_maj[0]);
+  out.T *= T_maj * (1.0 / T_maj[0]);
+  out.r_l *= T_maj * (1.0 / T_maj[0]);
+  out.r_u = out.T;
+  return out;
 }
 
 }  // namespace skyfarm

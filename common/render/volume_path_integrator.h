@@ -34,7 +34,9 @@
 
 #include "common/geometry/ray.h"
 #include "common/render/atmosphere_medium.h"
+#include "common/render/residual_ratio_tracking.h"
 #include "common/render/scene.h"
+#include "common/render/sunlit_intervals.h"
 #include "common/sampling/sampler.h"
 #include "common/spectrum/sampled_spectrum.h"
 
@@ -77,6 +79,12 @@ struct IntegratorOptions {
   // along long lit segments are heavy-tailed; for zenith views at twilight it
   // gains 10x.
   bool explicit_single_scattering = false;
+  // ... on the segments the planet's shadow cuts or that start with the sun
+  // below their local horizontal (twilight, and rays towards the dark side at
+  // sunset): collisions rarely reach their sunlit part, or find the sun only
+  // through long grazing air; the estimator samples the lit part alone.
+  // Never at day (the same bytes as without).  Measured in docs/physics.md.
+  bool sunlit_segments_in_shadow = true;
   // Forced collisions on the path's first segments (0: none, 1: the camera
   // ray, 2: and the ray after the first vertex, ...): both "no tentative
   // collision along the whole segment" (weight T_maj) and "at least one"
@@ -120,13 +128,21 @@ class VolumePathIntegrator {
   const Scene& scene() const { return scene_; }
 
  private:
+  // The same with the path's coefficients already looked up, and the
+  // collision pattern's spectral-MIS pdf ratios (TrackedTransmittance::r_l).
+  TrackedTransmittance tracked_transmittance(const Ray& ray, double t_end, const PathCoefficients& path,
+                                             Sampler& sampler, PathCounters* counters) const;
+
+ private:
   struct Vertex;
   // What a path carries between vertices: throughput, spectral-MIS ratios
   // (r_u unidirectional, r_l light sampling; pbrt-v4), and how it got here.
   struct PathState {
     SampledSpectrum beta{1.0}, r_u{1.0}, r_l{1.0};
     bool mis_with_sun = false;           // the previous vertex sampled the sun (NEE)
-    bool last_vertex_in_medium = false;  // the ray leaves a medium scattering vertex
+    // The ray leaves a medium vertex whose segment's sun light came from the
+    // sunlit-segment estimator (so the sun disk seen next is not counted).
+    bool sun_from_segment_estimator = false;
   };
   // What stays fixed along one path.
   struct PathContext {
@@ -151,9 +167,15 @@ class VolumePathIntegrator {
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
   bool survives(PathState* st, int depth, Sampler& sampler, PathCounters* counters) const;
-  SampledSpectrum sunlit_single_scattering(const Ray& ray, double t0, double t1, const SampledWavelengths& lambda,
-                                           const PathCoefficients& path, const PathPhases& phases, Sampler& sampler,
-                                           PathCounters* counters) const;
+  // The sunlit-segment estimate (without the path's throughput) and, per
+  // wavelength, its sampling pdf had that wavelength been the hero over the
+  // hero's (the point on the segment and both transmittances' collisions):
+  // the caller adds beta L / avg(r_u r).
+  struct SunlitSample {
+    SampledSpectrum L{0.0}, r{1.0};
+  };
+  SunlitSample sunlit_single_scattering(const Ray& ray, const SunlitIntervals& lit, const PathCoefficients& path,
+                                        const PathPhases& phases, Sampler& sampler, PathCounters* counters) const;
   // The camera ray's majorant inflation from its largest majorant optical depth.
   double camera_majorant_scale(double tau) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
