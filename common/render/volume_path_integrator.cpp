@@ -10,6 +10,7 @@
 #include "common/core/math.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/free_flight.h"
+#include "common/render/lit_distance_sampler.h"
 #include "common/render/recorded_shell_walk.h"
 #include "common/render/residual_ratio_tracking.h"
 #include "common/render/sunlit_intervals.h"
@@ -144,7 +145,8 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       explicit_single = options_.explicit_single_scattering || lit.shadowed ||
                         glm::dot(ray.o, scene_.sun().direction()) < 0.0;
       if (explicit_single) {
-        const SunlitSample ss = sunlit_single_scattering(ray, lit, path, phases, sampler, counters);
+        const SunlitSample ss =
+            sunlit_single_scattering(ray, extent.t_begin, extent.t_end, lit, path, phases, sampler, counters);
         if (!ss.L.is_zero()) L += st.beta * ss.L * (1.0 / (st.r_u * ss.r).average());
       }
     }
@@ -438,74 +440,40 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   return Ld * (1.0 / (r_l + r_u).average());
 }
 
-// Single scattering of sunlight along a camera ray, sampled where the sun is
+// Single scattering of sunlight along a segment, sampled where the sun is
 // visible (DESIGN §3.4; issue 5 "sampling the distance towards the sun"):
 //   L_ss = int_sunlit T(o, x_t) sigma_s(x_t) p(theta) T(x_t, sun) L_sun dt.
-// The sunlit part of [t0, t1] is the line minus the planet's shadow cylinder
-// (points x with x.s < 0 and |x - (x.s) s| < R, s towards the sun), at most
-// two intervals found in closed form.  Within them t is drawn from the hero
-// wavelength's majorant as free-flight sampling would, but truncated to the
-// lit intervals (taken end to end):
-//   pdf(t) = sigma_maj(t) exp(-tau_maj(t)) / (1 - exp(-tau_maj(lit))),
-// tau_maj(t) the majorant optical depth of the lit part up to t; the transmittances
-// are unbiased ratio-tracking estimates, the sun direction is sampled on the
-// disk.  When the sun is below the horizon this puts every sample where the
-// light is, instead of waiting for a rare collision high up.
+// The sunlit part of the segment is the line minus the planet's shadow
+// (sunlit_intervals.h).  t is drawn there from the majorant's truncated
+// exponential (lit_distance_sampler.h), in one sample of two: in the other
+// from the part whose sun ray clears the ground by kClearAltitude_m (the
+// atmosphere's own shadow: a sun ray grazing the dense low air arrives
+// nearly extinguished, yet that is where the majorant puts most points).
+// The mixture's pdf is the average of both (one-sample MIS, balance), at
+// every wavelength for the spectral MIS; the transmittances are (residual)
+// ratio-tracking estimates, the sun direction is sampled on the disk.
 VolumePathIntegrator::SunlitSample VolumePathIntegrator::sunlit_single_scattering(
-    const Ray& ray, const SunlitIntervals& lit_parts, const PathCoefficients& path, const PathPhases& phases,
-    Sampler& sampler, PathCounters* counters) const {
-  const auto& lit = lit_parts.lit;
-  const int n_lit = lit_parts.count;
+    const Ray& ray, double t0, double t1, const SunlitIntervals& lit, const PathCoefficients& path,
+    const PathPhases& phases, Sampler& sampler, PathCounters* counters) const {
+  constexpr double kClearAltitude_m = 20000.0;
   SunlitSample none;
   none.L = SampledSpectrum(0.0);
   const AtmosphereMedium& medium = scene_.medium();
   const double R = scene_.atmosphere().planet_radius_m();
-  // The hero's majorant optical depth of the sunlit intervals, their shell
-  // walks recorded for the inversion below.
-  const ShellMajorants& shells = medium.fine_shells();
-  std::array<std::optional<RecordedShellWalk>, 2> walks;
-  SampledSpectrum tau_lit(0.0);  // at every wavelength, for the spectral-MIS pdfs
-  for (int k = 0; k < n_lit; ++k) {
-    const auto [a, b] = lit[static_cast<std::size_t>(k)];
-    walks[static_cast<std::size_t>(k)].emplace(ShellTraversal(ray, R, shells.bottoms, a, b));
-    auto walk = walks[static_cast<std::size_t>(k)]->replay();
-    ShellSegment seg;
-    while (walk.next(&seg)) tau_lit += shells.sigma_maj(seg.shell, path.bins) * (seg.t1 - seg.t0);
-  }
-  const double u_t = sampler.next(), u_s1 = sampler.next(), u_s2 = sampler.next();
-  if (!(tau_lit[0] > 0.0)) return none;
-  // Invert: the point where the majorant optical depth reaches tau_star,
-  // drawn from the truncated exponential p(tau) = e^-tau / (1 - e^-tau_lit)
-  // so that long, dense lit segments (the horizon at noon) sample near the
-  // camera, where T(o, x_t) keeps the light, and thin ones (twilight) almost
-  // uniformly in tau, i.e. where the lit air is densest.
-  const double lit_mass = -std::expm1(-tau_lit[0]);
-  const double tau_star = std::min(tau_lit[0], -std::log1p(-u_t * lit_mass));
-  double target = tau_star, t = -1.0;
-  SampledSpectrum sigma_maj_t(0.0), tau_t(0.0);  // at t, and the lit optical depth up to t
-  for (int k = 0; k < n_lit && t < 0.0; ++k) {
-    auto walk = walks[static_cast<std::size_t>(k)]->replay();
-    ShellSegment seg;
-    while (walk.next(&seg)) {
-      const SampledSpectrum m = shells.sigma_maj(seg.shell, path.bins);
-      const double tau_seg = m[0] * (seg.t1 - seg.t0);
-      if (m[0] > 0.0 && target <= tau_seg) {
-        t = seg.t0 + target / m[0];
-        sigma_maj_t = m;
-        tau_t += m * (t - seg.t0);
-        break;
-      }
-      target -= tau_seg;
-      tau_t += m * (seg.t1 - seg.t0);
-    }
-  }
-  if (t < 0.0 || !(sigma_maj_t[0] > 0.0)) return none;
-  // pdf of t had each wavelength been the hero (truncated exponential of its
-  // own majorant); the hero's is the estimator's.
-  SampledSpectrum pdf_t_all;
-  for (int i = 0; i < kWavelengthsPerPath; ++i)
-    pdf_t_all[i] = sigma_maj_t[i] * std::exp(-tau_t[i]) / -std::expm1(-tau_lit[i]);
+  const glm::dvec3 s = scene_.sun().direction();
+  const LitDistanceSampler in_lit(ray, lit, R, medium.fine_shells(), path.bins);
+  const LitDistanceSampler in_clear(ray, sunlit_intervals(ray, t0, t1, s, R + kClearAltitude_m), R,
+                                    medium.fine_shells(), path.bins);
+  const double u_t = sampler.next(), u_s1 = sampler.next(), u_s2 = sampler.next(), u_pick = sampler.next();
+  if (in_lit.empty()) return none;
+  const double w_clear = in_clear.empty() ? 0.0 : 0.5;
+  double t = -1.0;
+  if (!(u_pick < w_clear ? in_clear.sample(u_t, &t) : in_lit.sample(u_t, &t))) return none;
+  // pdf of t had each wavelength been the hero; the hero's is the estimator's.
+  const SampledSpectrum pdf_t_all =
+      in_lit.pdf(t) * (1.0 - w_clear) + (w_clear > 0.0 ? in_clear.pdf(t) * w_clear : SampledSpectrum(0.0));
   const double pdf_t = pdf_t_all[0];
+  if (!(pdf_t > 0.0)) return none;
   const glm::dvec3 x = ray.at(t);
   MediumPoint mp;
   medium.point(glm::length(x) - R, path, &mp);

@@ -172,8 +172,9 @@ class VolumePathIntegrator {
   struct SunlitSample {
     SampledSpectrum L{0.0}, r{1.0};
   };
-  SunlitSample sunlit_single_scattering(const Ray& ray, const SunlitIntervals& lit, const PathCoefficients& path,
-                                        const PathPhases& phases, Sampler& sampler, PathCounters* counters) const;
+  SunlitSample sunlit_single_scattering(const Ray& ray, double t0, double t1, const SunlitIntervals& lit,
+                                        const PathCoefficients& path, const PathPhases& phases, Sampler& sampler,
+                                        PathCounters* counters) const;
   // The camera ray's majorant inflation from its largest majorant optical depth.
   double camera_majorant_scale(double tau) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
