@@ -314,12 +314,14 @@ SessionEnd FarmWorker::Impl::serve(zmq::socket_t& socket) {
       if (!message) break;
       if (const auto end = handle(socket, *message)) return *end;
     }
-    forward_outcomes(socket);
+    // A drain is announced before any result goes out: a result returns a
+    // credit, and the server must not spend it on a new unit for us.
     if (drain_requested() && !draining_) {
       draining_ = true;
       log("worker " + options.id + ": draining (" + std::to_string(units_.size()) + " units to finish)");
       send(socket, heartbeat());
     }
+    forward_outcomes(socket);
     if (draining_ && units_.empty()) {
       send(socket, api::DisconnectMsg{"worker draining", false});
       return SessionEnd::kDrained;

@@ -273,26 +273,59 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
 // A real scattering in the medium at p: the next direction from the mixture
 // phase function (a constituent picked by its share of sigma_s at the hero
 // wavelength, then its phase function sampled); false if it has no pdf.
+// Concentration and elevation of the twilight guide's lobe.
+constexpr double kGuideKappa = 10.0;
+constexpr double kGuideElevation_rad = 5.0 * kDegToRad;
+
+std::optional<glm::dvec3> VolumePathIntegrator::twilight_guide(const glm::dvec3& p) const {
+  if (!(options_.twilight_guide_fraction > 0.0) || !scene_.sun_enabled) return std::nullopt;
+  const glm::dvec3 s = scene_.sun().direction();
+  const double ps = glm::dot(p, s), R = scene_.atmosphere().planet_radius_m();
+  if (!(ps < 0.0 && glm::dot(p, p) - ps * ps < R * R)) return std::nullopt;  // not in the shadow
+  const glm::dvec3 n = glm::normalize(p);
+  const glm::dvec3 towards_sun = s - glm::dot(s, n) * n;  // the sun's azimuth on the local horizontal
+  const double len = glm::length(towards_sun);
+  if (!(len > 0.0)) return std::nullopt;
+  return std::cos(kGuideElevation_rad) * (towards_sun / len) + std::sin(kGuideElevation_rad) * n;
+}
+
+// A real scattering in the medium at p: the next direction from the mixture
+// phase function (a constituent picked by its share of sigma_s at the hero
+// wavelength, then its phase function sampled) or, in the planet's shadow,
+// a share of the time from the twilight guide's lobe; the pdf is the
+// mixture's (per wavelength, for the spectral MIS); false if it has none.
 bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPoint& mp, const PathPhases& phases,
                                              Sampler& sampler, Ray* ray, PathState* st) const {
-  double pick = sampler.next() * mp.sigma_s[0];
-  int s = 0;
-  while (s + 1 < phases.count() && pick >= mp.sigma_s_c[static_cast<std::size_t>(s)][0]) {
-    pick -= mp.sigma_s_c[static_cast<std::size_t>(s)][0];
-    ++s;
+  const std::optional<glm::dvec3> guide = twilight_guide(p);
+  const double alpha = guide ? options_.twilight_guide_fraction : 0.0;
+  glm::dvec3 wi;
+  if (guide && sampler.next() < alpha) {
+    const glm::dvec3 local = square_to_von_mises_fisher({sampler.next(), sampler.next()}, kGuideKappa);
+    wi = glm::normalize(Frame(*guide).to_world(local));
+    sampler.next();  // as many numbers as the phase branch
+  } else {
+    double pick = sampler.next() * mp.sigma_s[0];
+    int s = 0;
+    while (s + 1 < phases.count() && pick >= mp.sigma_s_c[static_cast<std::size_t>(s)][0]) {
+      pick -= mp.sigma_s_c[static_cast<std::size_t>(s)][0];
+      ++s;
+    }
+    const double mu = clamp_cos(phases.sample_cos_theta(s, sampler.next()));
+    const double phi = 2.0 * kPi * sampler.next();
+    const double sin_theta = safe_sqrt(1.0 - mu * mu);
+    wi = glm::normalize(Frame(ray->d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
   }
-  const double mu = clamp_cos(phases.sample_cos_theta(s, sampler.next()));
-  const double phi = 2.0 * kPi * sampler.next();
-  const double sin_theta = safe_sqrt(1.0 - mu * mu);
-  const glm::dvec3 wi =
-      glm::normalize(Frame(ray->d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
-  const SampledSpectrum p_mix = mixture_phase(mp, phases, mu);
-  const double pdf_dir = p_mix[0];
+  const SampledSpectrum p_mix = mixture_phase(mp, phases, clamp_cos(glm::dot(ray->d, wi)));
+  SampledSpectrum pdf = p_mix;  // per wavelength, had it been the hero
+  if (guide) {
+    const double p_guide = square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa);
+    pdf = p_mix * (1.0 - alpha) + SampledSpectrum(alpha * p_guide);
+  }
+  const double pdf_dir = pdf[0];
   if (!(pdf_dir > 0.0)) return false;
-  const SampledSpectrum ratio = p_mix * (1.0 / pdf_dir);
   st->r_l = st->r_u * (1.0 / pdf_dir);
-  st->beta *= ratio;
-  st->r_u *= ratio;
+  st->beta *= p_mix * (1.0 / pdf_dir);
+  st->r_u *= pdf * (1.0 / pdf_dir);
   *ray = Ray{p, wi};
   return true;
 }
@@ -380,6 +413,11 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
     pdf_scatter = f;
+    if (const std::optional<glm::dvec3> guide = twilight_guide(v.p)) {  // (penumbra: the disk partly seen)
+      const double alpha = options_.twilight_guide_fraction;
+      pdf_scatter = f * (1.0 - alpha) + SampledSpectrum(
+          alpha * square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa));
+    }
   }
   if (f.is_zero()) return SampledSpectrum(0.0);
 

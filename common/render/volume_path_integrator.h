@@ -31,6 +31,7 @@
 //   rr_start_depth    Russian roulette on throughput from this depth on
 #pragma once
 #include <cstdint>
+#include <optional>
 
 #include "common/geometry/ray.h"
 #include "common/render/atmosphere_medium.h"
@@ -83,6 +84,11 @@ struct IntegratorOptions {
   // through long grazing air; the estimator samples the lit part alone.
   // Never at day (the same bytes as without).  Measured in docs/physics.md.
   bool sunlit_segments_in_shadow = true;
+  // At medium vertices in the planet's shadow, this share of the scattering
+  // directions is drawn from a von Mises-Fisher lobe (kappa 10) aimed at the
+  // sun's azimuth 5 deg above the local horizontal, where the lit air is
+  // (twilight); the pdf is the mixture with the phase function's (MIS).
+  double twilight_guide_fraction = 0.3;
   // Forced collisions on the path's first segments (0: none, 1: the camera
   // ray, 2: and the ray after the first vertex, ...): both "no tentative
   // collision along the whole segment" (weight T_maj) and "at least one"
@@ -169,6 +175,8 @@ class VolumePathIntegrator {
   // wavelength, its sampling pdf had that wavelength been the hero over the
   // hero's (the point on the segment and both transmittances' collisions):
   // the caller adds beta L / avg(r_u r).
+  // The twilight guide's axis at p (in the planet's shadow), or nothing.
+  std::optional<glm::dvec3> twilight_guide(const glm::dvec3& p) const;
   struct SunlitSample {
     SampledSpectrum L{0.0}, r{1.0};
   };

@@ -1,6 +1,7 @@
 // Square-to-sphere warps and the orthonormal frame (see warps.h).
 #include "common/sampling/warps.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/geometric.hpp>
 
@@ -95,6 +96,17 @@ glm::dvec3 square_to_uniform_cone_of_height(const glm::dvec2& u, double h) {
 double square_to_uniform_cone_pdf(const glm::dvec3& w, double theta_max) {
   const double theta = std::atan2(std::hypot(w.x, w.y), w.z);
   return theta <= theta_max ? 1.0 / uniform_cone_solid_angle(theta_max) : 0.0;
+}
+
+glm::dvec3 square_to_von_mises_fisher(const glm::dvec2& u, double kappa) {
+  const double w_z = std::clamp(1.0 + std::log(u.x + (1.0 - u.x) * std::exp(-2.0 * kappa)) / kappa, -1.0, 1.0);
+  const double r = std::sqrt(std::max(0.0, (1.0 - w_z) * (1.0 + w_z)));
+  const double phi = 2.0 * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), w_z};
+}
+
+double square_to_von_mises_fisher_pdf(double cos_theta, double kappa) {
+  return kappa / (2.0 * kPi * -std::expm1(-2.0 * kappa)) * std::exp(kappa * (cos_theta - 1.0));
 }
 
 // Orthonormal basis from a unit vector, Duff, Burgess, Christensen, Hery,

@@ -54,6 +54,13 @@ glm::dvec3 square_to_uniform_cone_of_height(const glm::dvec2& u, double h);
 // 1 / solid angle inside the cone (angle to +z <= theta_max), 0 outside.
 double square_to_uniform_cone_pdf(const glm::dvec3& w, double theta_max);
 
+// --- Von Mises-Fisher lobe about +z, concentration kappa > 0 ------------
+//   pdf(w) = kappa / (2 pi (1 - e^{-2 kappa})) e^{kappa (w.z - 1)},
+// sampled exactly (Jakob 2012, "Numerically stable sampling of the von
+// Mises-Fisher distribution on S^2"): w.z = 1 + ln(u + (1 - u) e^{-2 kappa}) / kappa.
+glm::dvec3 square_to_von_mises_fisher(const glm::dvec2& u, double kappa);
+double square_to_von_mises_fisher_pdf(double cos_theta, double kappa);
+
 // --- Orthonormal frame ---------------------------------------------------
 // (s, t, n) right-handed and orthonormal; to_world(0,0,1) == n.
 struct Frame {

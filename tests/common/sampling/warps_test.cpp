@@ -95,6 +95,20 @@ TEST(Warps, UniformSphere) {
   for (const glm::dvec2& u : kEdgeUs) EXPECT_NEAR(glm::length(square_to_uniform_sphere(u)), 1.0, 1e-15);
 }
 
+TEST(Warps, VonMisesFisher) {
+  for (double kappa : {0.5, 10.0, 200.0}) {
+    auto pdf = [kappa](const glm::dvec3& w) { return square_to_von_mises_fisher_pdf(w.z, kappa); };
+    // Sharp lobes need the quadrature's panels near the pole.
+    std::vector<double> breaks;
+    for (double b : {1.0 - 10.0 / kappa, 1.0 - 1.0 / kappa})
+      if (b > -1.0) breaks.push_back(b);
+    EXPECT_NEAR(integrate_sphere(pdf, breaks), 1.0, 1e-6) << "kappa " << kappa;
+    expect_sphere_chi2("von_mises_fisher k=" + std::to_string(kappa),
+                       [kappa](const glm::dvec2& u) { return square_to_von_mises_fisher(u, kappa); }, pdf, 11);
+    for (const glm::dvec2& u : kEdgeUs) EXPECT_NEAR(glm::length(square_to_von_mises_fisher(u, kappa)), 1.0, 1e-12);
+  }
+}
+
 TEST(Warps, UniformHemisphere) {
   EXPECT_NEAR(integrate_sphere(square_to_uniform_hemisphere_pdf, {0.0}), 1.0, 1e-12);
   expect_sphere_chi2("uniform_hemisphere", square_to_uniform_hemisphere, square_to_uniform_hemisphere_pdf, 2);
