@@ -131,7 +131,10 @@ struct Job {
                static_cast<std::size_t>(plan.batches) +
            static_cast<std::size_t>(u.batch);
   }
-  bool active() const { return !is_terminal(record.state); }
+  // Stopped, its final image being written outside the service's lock
+  // (finish_if_complete, then complete_finish): no more units, not yet done.
+  bool finishing = false;
+  bool active() const { return !finishing && !is_terminal(record.state); }
   bool has_work() const {
     return active() && (!requeued.empty() || cursor < static_cast<std::size_t>(plan.unit_count()));
   }
@@ -178,7 +181,16 @@ struct JobService::Impl {
   void set_state(Job& job, const std::string& state, const std::string& failure = "");
   void emit(Job& job, const std::string& type);
   nlohmann::json status_of(const Job& job) const;
-  void finish_if_complete(Job& job);
+  // A stopped job's final image, to be written outside the lock, then
+  // complete_finish (under it) makes the job done.
+  struct PendingFinish {
+    ImageSnapshot final_image;
+    std::string stopped_by;
+  };
+  std::optional<PendingFinish> finish_if_complete(Job& job);
+  void complete_finish(Job& job, const std::string& stopped_by);
+  // Under the lock (start-up): finish_if_complete, the write, complete_finish.
+  void finish_now_if_complete(Job& job);
   void write_images(Job& job, bool final);
   // The images of a job's merged sums, resolved under the lock, and written
   // (encoded and stored) by write_snapshot without it.
@@ -209,7 +221,7 @@ JobService::JobService(fs::path data_dir, ServiceLimits limits) : impl_(std::mak
     if (job.record.state == "running") impl_->set_state(job, "queued");
     if (job.record.state == "done" && !fs::exists(job.dir / "image.exr")) impl_->write_images(job, true);
     if (job.record.state == "done") job.preview_units = job.merger->merged_units();
-    impl_->finish_if_complete(job);
+    impl_->finish_now_if_complete(job);
   }
 }
 
@@ -276,7 +288,7 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
   // Result cache: an identical request that is done, or still on its way.
   for (const auto& id : impl_->order) {
     const Job& job = *impl_->jobs.at(id);
-    if (job.record.request_hash == hash && (job.record.state == "done" || job.active())) {
+    if (job.record.request_hash == hash && (job.record.state == "done" || job.active() || job.finishing)) {
       if (key) impl_->idempotency[*key] = job.record.id;
       return {job.record.id, false, job.record.state == "done"};
     }
@@ -664,8 +676,8 @@ bool stops_early(const Job& job) {
 // merged, its target error is reached, or its time limit has passed (checked
 // at pass boundaries: the pass in progress completes, so the image is always
 // a whole number of passes and equals a local render of that many passes).
-void JobService::Impl::finish_if_complete(Job& job) {
-  if (!job.active()) return;
+std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_complete(Job& job) {
+  if (!job.active()) return std::nullopt;
   std::string stop;
   while (stop.empty()) {
     const int passes = job.merger->complete_passes();
@@ -699,19 +711,33 @@ void JobService::Impl::finish_if_complete(Job& job) {
     break;
   }
   if (stop.empty() && job.merger->complete()) stop = "samples";
-  if (stop.empty()) return;
+  if (stop.empty()) return std::nullopt;
   drop_attempts_of(job);
   job.merger->drop_waiting();
-  write_images(job, true);
+  job.finishing = true;
+  return PendingFinish{snapshot_images(job, true), stop};
+}
+
+void JobService::Impl::complete_finish(Job& job, const std::string& stopped_by) {
+  job.finishing = false;
+  // A done job serves its final image: the last preview goes.
+  if (job.preview_units >= 0) remove_preview(job.dir, job.preview_units);
   job.preview_units = job.merger->merged_units();
-  job.stopped_by = stop;
+  job.stopped_by = stopped_by;
   set_state(job, "done");
   emit(job, "done");
 }
 
+void JobService::Impl::finish_now_if_complete(Job& job) {
+  if (std::optional<PendingFinish> pending = finish_if_complete(job)) {
+    write_snapshot(pending->final_image);
+    complete_finish(job, pending->stopped_by);
+  }
+}
+
 void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std::uint64_t attempt,
                            const std::vector<std::uint8_t>& bytes, std::uint64_t paths) {
-  const std::lock_guard<std::mutex> lock(impl_->mu);
+  std::unique_lock<std::mutex> lock(impl_->mu);
   const auto it = impl_->in_flight.find(attempt);
   // A superseded attempt (requeued after a timeout or a lost worker) or a
   // cancelled job: the result is dropped.
@@ -746,13 +772,29 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
     impl_->fail_job(job, e.what());
     return;
   }
-  try {
-    impl_->finish_if_complete(job);
-  } catch (const StorageError& e) {
-    impl_->fail_job(job, e.what());
+  std::optional<Impl::PendingFinish> pending = impl_->finish_if_complete(job);
+  if (!pending) {
+    if (job.active()) impl_->emit(job, "progress");
     return;
   }
-  if (job.active()) impl_->emit(job, "progress");
+  // The final image is encoded and written without the lock: a large one
+  // takes seconds, and dispatch, merging and status requests go on meanwhile
+  // (the job, finishing, gets no units).  Jobs are never erased, so `job`
+  // stays valid.
+  lock.unlock();
+  std::optional<std::string> failure;
+  try {
+    write_snapshot(pending->final_image);
+  } catch (const StorageError& e) {
+    failure = e.what();
+  }
+  lock.lock();
+  if (failure) {
+    job.finishing = false;
+    impl_->fail_job(job, *failure);
+    return;
+  }
+  impl_->complete_finish(job, pending->stopped_by);
 }
 
 void JobService::unit_failed(const std::string& worker_id, const UnitKey& key, std::uint64_t attempt,
