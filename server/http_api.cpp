@@ -380,17 +380,13 @@ void HttpApi::list(const Request& req, Response& res) {
 
 void HttpApi::status(const Request& req, Response& res) {
   const std::string id = job_id_of(req);
-  const std::optional<nlohmann::json> doc = backend_.status(id);
-  if (!doc) throw not_found(id);
-  send_json(res, 200, *doc);
+  send_json_or_throw(res, 200, backend_.status(id), not_found(id));
 }
 
 void HttpApi::cancel(const Request& req, Response& res) {
   const std::string id = job_id_of(req);
   if (!backend_.cancel(id)) throw not_found(id);
-  const std::optional<nlohmann::json> doc = backend_.status(id);
-  if (!doc) throw not_found(id);
-  send_json(res, 202, *doc);
+  send_json_or_throw(res, 202, backend_.status(id), not_found(id));
 }
 
 void HttpApi::image_exr(const Request& req, Response& res) { image(req, res, ImageFormat::kExr); }

@@ -169,4 +169,10 @@ void send_json(httplib::Response& res, int status, const nlohmann::json& body, c
   res.set_content(dump_json(body), content_type);
 }
 
+void send_json_or_throw(httplib::Response& res, int status, const std::optional<nlohmann::json>& doc,
+                        const HttpError& missing) {
+  if (!doc) throw missing;
+  send_json(res, status, *doc);
+}
+
 }  // namespace skyfarm::server

@@ -3,6 +3,7 @@
 // titles, types and the "errors" extension are the same on every route.
 #pragma once
 #include <exception>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -80,5 +81,9 @@ std::string dump_json(const nlohmann::json& value);
 // Sets a JSON body (application/json unless told otherwise).
 void send_json(httplib::Response& res, int status, const nlohmann::json& body,
                const char* content_type = "application/json");
+// Sends a resource's document (a status) with `status`, or throws `missing`
+// (its 404) when the resource is unknown.
+void send_json_or_throw(httplib::Response& res, int status, const std::optional<nlohmann::json>& doc,
+                        const HttpError& missing);
 
 }  // namespace skyfarm::server

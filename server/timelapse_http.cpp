@@ -100,17 +100,13 @@ void TimelapseHttp::list(const Request& req, Response& res) const {
 
 void TimelapseHttp::status(const Request& req, Response& res) const {
   const std::string id = id_of(req);
-  const std::optional<nlohmann::json> doc = service_.status(id);
-  if (!doc) throw not_found(id);
-  send_json(res, 200, *doc);
+  send_json_or_throw(res, 200, service_.status(id), not_found(id));
 }
 
 void TimelapseHttp::cancel(const Request& req, Response& res) {
   const std::string id = id_of(req);
   if (!service_.cancel(id)) throw not_found(id);
-  const std::optional<nlohmann::json> doc = service_.status(id);
-  if (!doc) throw not_found(id);
-  send_json(res, 202, *doc);
+  send_json_or_throw(res, 202, service_.status(id), not_found(id));
 }
 
 void TimelapseHttp::frames(const Request& req, Response& res) const {
