@@ -169,7 +169,7 @@ TEST(RenderRequestDefaults, MinimalRequestGetsEveryDefault) {
   EXPECT_EQ(r.atmosphere.top_altitude_m, 100000.0);
   EXPECT_EQ(r.spectral.min_nm, 360.0);
   EXPECT_EQ(r.spectral.max_nm, 830.0);
-  EXPECT_EQ(r.spectral.batches, 4);
+  EXPECT_EQ(r.spectral.batches, 1);
   EXPECT_EQ(r.quality.samples_per_pixel, 64);
   EXPECT_FALSE(r.quality.target_relative_error.has_value());
   EXPECT_FALSE(r.quality.time_limit_s.has_value());
@@ -542,7 +542,7 @@ TEST(RenderRequestCanonical, SameMeaningSameText) {
                      "location": {"latitude_deg": 0.0, "longitude_deg": -0.0}, "time": "2013-05-27T13:30Z",
                      "method": "path", "priority": 50, "output": {"exposure_ev": null, "half": true},
                      "atmosphere": {"preset": "earth", "ozone_du": 300, "aerosol": {"optical_depth_550": 0.1}},
-                     "spectral": {"min_nm": 360, "max_nm": 830, "batches": 4},
+                     "spectral": {"min_nm": 360, "max_nm": 830, "batches": 1},
                      "quality": {"samples_per_pixel": 64, "target_relative_error": null}})"));
   // earth_clear is earth without aerosols.
   EXPECT_EQ(text(with(R"("atmosphere": {"preset": "earth_clear"})")),
