@@ -185,7 +185,7 @@ double fitted_slope(const std::vector<double>& t, const std::vector<double>& e) 
 
 int run_bench_convergence(const std::vector<std::string>& args) {
   fs::path dir = "skyfarm-convergence";
-  int passes = 32;
+  int passes = 32, seed = 1;
   std::string only;
   IntegratorOptions options;
   for (std::size_t i = 0; i < args.size(); ++i) {
@@ -200,10 +200,13 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     else if (args[i] == "--sunlit-segments")
       options.explicit_single_scattering = true;
     else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
+    else if (args[i] == "--seed" && i + 1 < args.size()) seed = std::atoi(args[++i].c_str());
+    else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size())
+      options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
-                   "  [--no-sunlit-in-shadow]\n";
+                   "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W]\n";
       return 2;
     }
   }
@@ -211,7 +214,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
   for (const Scene_& s : kScenes) {
     if (!only.empty() && only != s.name) continue;
     const std::vector<double> ref = reference(s, passes * 16, dir);
-    const auto request = api::parse_render_request(request_json(s, passes * 16, 1));
+    const auto request = api::parse_render_request(request_json(s, passes * 16, seed));
     const api::RenderSetup setup = api::make_render_setup(request);
     const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan, options);
     const std::vector<bool> keep = sky_mask(setup);

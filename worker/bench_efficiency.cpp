@@ -97,6 +97,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       options.camera_target_collisions = std::atof(args[++i].c_str());
     } else if (args[i] == "--rr-start-depth" && i + 1 < args.size()) {
       options.rr_start_depth = std::atoi(args[++i].c_str());
+    } else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size()) {
+      options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
     } else if (args[i] == "--breakdown") {
       breakdown = true;
     } else if (args[i] == "--sunlit-segments") {
@@ -110,7 +112,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
     } else {
       std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
-                   "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D] [--breakdown]\n";
+                   "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
+                   "  [--rr-threshold-in-shadow W] [--breakdown]\n";
       return 2;
     }
   }

@@ -266,7 +266,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
     }
     st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
     st.sun_from_segment_estimator = explicit_single;
-    if (!survives(&st, depth, sampler, counters)) return L;
+    if (!survives(&st, ray.o, depth, sampler, counters)) return L;
   }
 }
 
@@ -277,11 +277,17 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
 constexpr double kGuideKappa = 10.0;
 constexpr double kGuideElevation_rad = 5.0 * kDegToRad;
 
+// Whether the planet hides the sun's centre from p (the cylinder behind it).
+bool VolumePathIntegrator::in_planet_shadow(const glm::dvec3& p) const {
+  if (!scene_.sun_enabled) return false;
+  const double ps = glm::dot(p, scene_.sun().direction()), R = scene_.atmosphere().planet_radius_m();
+  return ps < 0.0 && glm::dot(p, p) - ps * ps < R * R;
+}
+
 std::optional<glm::dvec3> VolumePathIntegrator::twilight_guide(const glm::dvec3& p) const {
   if (!(options_.twilight_guide_fraction > 0.0) || !scene_.sun_enabled) return std::nullopt;
+  if (!in_planet_shadow(p)) return std::nullopt;
   const glm::dvec3 s = scene_.sun().direction();
-  const double ps = glm::dot(p, s), R = scene_.atmosphere().planet_radius_m();
-  if (!(ps < 0.0 && glm::dot(p, p) - ps * ps < R * R)) return std::nullopt;  // not in the shadow
   const glm::dvec3 n = glm::normalize(p);
   const glm::dvec3 towards_sun = s - glm::dot(s, n) * n;  // the sun's azimuth on the local horizontal
   const double len = glm::length(towards_sun);
@@ -370,16 +376,21 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
   st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
-  return survives(st, depth, c.sampler, c.counters);
+  return survives(st, p, depth, c.sampler, c.counters);
 }
 
 // Russian roulette on the MIS-normalised throughput after the vertex at
-// `depth`, and the depth cap; false ends the path.
-bool VolumePathIntegrator::survives(PathState* st, int depth, Sampler& sampler, PathCounters* counters) const {
+// `depth` (at p), against 1 or, in the planet's shadow, the lower
+// rr_threshold_in_shadow: a throughput beta below the threshold w survives
+// with probability beta / w and becomes w; and the depth cap.  False ends
+// the path.
+bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, int depth, Sampler& sampler,
+                                   PathCounters* counters) const {
   if (st->beta.is_zero()) return false;
   const SampledSpectrum rr_beta = st->beta * (1.0 / st->r_u.average());
-  if (depth + 1 >= options_.rr_start_depth && rr_beta.max() < 1.0) {
-    const double q = std::max(0.0, 1.0 - rr_beta.max());
+  const double w = in_planet_shadow(p) ? options_.rr_threshold_in_shadow : 1.0;
+  if (depth + 1 >= options_.rr_start_depth && w > 0.0 && rr_beta.max() < w) {
+    const double q = std::max(0.0, 1.0 - rr_beta.max() / w);
     if (sampler.next() < q) return false;
     st->beta *= 1.0 / (1.0 - q);
   }

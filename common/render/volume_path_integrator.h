@@ -29,6 +29,7 @@
 //   max_depth         hard cap on scattering events (a cost bound; hits are
 //                     counted in PathCounters::depth_limit so tests keep it 0)
 //   rr_start_depth    Russian roulette on throughput from this depth on
+//                     (below rr_threshold_in_shadow in the planet's shadow)
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -48,6 +49,15 @@ class PathMajorants;
 struct IntegratorOptions {
   int max_depth = 10000;
   int rr_start_depth = 2;
+  // Russian roulette plays on a throughput below this at vertices in the
+  // planet's shadow (1 elsewhere), and survivors carry it: a twilight path
+  // scattering in the dark air is still on its way to the lit air, where
+  // most of its value lies, and killing it at its throughput's odds made
+  // the rare survivors the heavy tail of the image.  Measured (bench
+  // convergence, twilight 96 deg, 512 spp, against an 8192-spp reference):
+  // true error 0.233 -> 0.165, estimate/true at 16 spp 0.34 -> 0.66, for
+  // about 1.2x the collisions; day vertices never use it (the same bytes).
+  double rr_threshold_in_shadow = 0.25;
   // Camera rays whose majorants promise fewer than this many tentative
   // collisions inflate them (up to max_camera_majorant_scale) so that each
   // gathers the sun in expectation at about this many points (see the .cpp).
@@ -170,7 +180,8 @@ class VolumePathIntegrator {
                          Ray* ray, PathState* st) const;
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
-  bool survives(PathState* st, int depth, Sampler& sampler, PathCounters* counters) const;
+  bool survives(PathState* st, const glm::dvec3& p, int depth, Sampler& sampler, PathCounters* counters) const;
+  bool in_planet_shadow(const glm::dvec3& p) const;
   // The sunlit-segment estimate (without the path's throughput) and, per
   // wavelength, its sampling pdf had that wavelength been the hero over the
   // hero's (the point on the segment and both transmittances' collisions):

@@ -230,6 +230,44 @@ TEST(IntegratorPhysics, TwilightGuideKeepsTheMean) {
   }
 }
 
+// --- Russian roulette against a lower threshold in the planet's shadow
+// keeps the mean (any survival probability does), keeps twilight paths
+// alive longer (more collisions per path: the paths it used to kill carried
+// the light from the lit air), and never applies by day: the same values,
+// bit for bit.  Its effect on the error is measured in bench convergence
+// (docs/physics.md, "Efficiency"), not here: a twilight path's relative std
+// is about 7, so a sample variance is too noisy for an assertion.
+TEST(IntegratorPhysics, ShadowRouletteThresholdKeepsTheMeanAndLeavesDaylightAlone) {
+  IntegratorOptions low, one;
+  low.rr_threshold_in_shadow = 0.25;
+  one.rr_threshold_in_shadow = 1.0;
+  const std::array<double, 4> lambdas = {430.0, 510.0, 590.0, 660.0};
+  const Scene twilight =
+      Scene::from_specs(AtmosphereSpec{}, sun_at(96.0, 0.0, 0.0), Location{}, std::nullopt, 400.0, 700.0);
+  const VolumePathIntegrator a(twilight, low), b(twilight, one);
+  PathCounters counters_a, counters_b;
+  for (int d = 0; d < 5; ++d) {
+    const Ray ray{twilight.observer(), direction_from_zenith_azimuth((20.0 + 30.0 * d) * kDegToRad, 0.7 * d)};
+    const RotatedHeroMoments ma = radiance_with_rotated_hero(a, ray, lambdas, 8000, 41 + d);
+    const RotatedHeroMoments mb = radiance_with_rotated_hero(b, ray, lambdas, 8000, 51 + d);
+    counters_a.add(ma.counters);
+    counters_b.add(mb.counters);
+    for (std::size_t k = 0; k < 4; ++k)
+      EXPECT_NEAR(ma.mean[k], mb.mean[k], 4.0 * std::hypot(ma.se[k], mb.se[k]))
+          << "direction " << d << ", " << lambdas[k] << " nm";
+  }
+  EXPECT_EQ(counters_a.nonfinite + counters_b.nonfinite, 0u);
+  EXPECT_GT(counters_a.collisions, counters_b.collisions * 11 / 10);
+
+  const Scene noon = Scene::from_specs(AtmosphereSpec{}, sun_at(30.0, 0.0, 0.0), Location{}, std::nullopt, 400.0, 700.0);
+  const VolumePathIntegrator c(noon, low), e(noon, one);
+  const Ray ray{noon.observer(), direction_from_zenith_azimuth(70.0 * kDegToRad, 2.0)};
+  const RotatedHeroMoments mc = radiance_with_rotated_hero(c, ray, lambdas, 2000, 7);
+  const RotatedHeroMoments me = radiance_with_rotated_hero(e, ray, lambdas, 2000, 7);
+  EXPECT_EQ(mc.mean, me.mean);
+  EXPECT_EQ(mc.counters.collisions, me.counters.collisions);
+}
+
 // --- White furnace: a non-absorbing atmosphere over a white ground under a
 // uniform sky light L_env (no sun) has radiance L_env everywhere, from any
 // viewpoint, whatever the density profiles and phase functions (energy
