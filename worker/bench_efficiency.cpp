@@ -105,6 +105,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       options.explicit_single_scattering = true;
     } else if (args[i] == "--residual-below-cos" && i + 1 < args.size()) {
       options.residual_tracking_below_cos = std::atof(args[++i].c_str());
+    } else if (args[i] == "--residual-below-altitude" && i + 1 < args.size()) {
+      options.residual_tracking_below_altitude_m = std::atof(args[++i].c_str());
     } else if (args[i] == "--no-sunlit-in-shadow") {
       options.sunlit_segments_in_shadow = false;
     } else if (args[i] == "--plain-ratio-tracking") {
@@ -113,7 +115,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
                    "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
-                   "  [--rr-threshold-in-shadow W] [--breakdown]\n";
+                   "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n";
       return 2;
     }
   }

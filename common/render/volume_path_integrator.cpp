@@ -401,6 +401,15 @@ bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, int dept
   return true;
 }
 
+// Whether a shadow ray from p along wi is tracked by residual ratio tracking
+// (IntegratorOptions: grazing rays, and rays that start in the low, dense
+// air) rather than ratio tracking through the coarse shells.
+bool VolumePathIntegrator::residual_tracking_pays(const glm::dvec3& p, const glm::dvec3& wi) const {
+  const double r = glm::length(p);
+  return glm::dot(p, wi) < options_.residual_tracking_below_cos * r ||
+         r - scene_.atmosphere().planet_radius_m() < options_.residual_tracking_below_altitude_m;
+}
+
 // Next-event estimation of the sun from a vertex (pbrt-v4 SampleLd, with
 // per-wavelength scattering pdfs because the mixture phase depends on l):
 //   L_d = beta f T L_sun / avg_i(r_p,i (pdf_light r_l,ray,i + pdf_scatter,i r_u,ray,i)),
@@ -439,7 +448,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   const SphereHit top = intersect_sphere(radial, atmosphere.top_radius_m());
   SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
   if (top.hit && top.t_far > 0.0 && options_.residual_ratio_tracking &&
-      glm::dot(v.p, wi) < options_.residual_tracking_below_cos * glm::length(v.p)) {
+      residual_tracking_pays(v.p, wi)) {
     const TrackedTransmittance tracked =
         residual_ratio_tracking(scene_.medium(), shadow, radial, std::max(0.0, top.t_near), top.t_far, *v.path,
                                 sampler, &counters->collisions, true);

@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/core/constants.h"
+#include "common/core/math.h"
 #include "common/core/integrate.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/radiance_probe.h"
@@ -266,6 +267,31 @@ TEST(IntegratorPhysics, ShadowRouletteThresholdKeepsTheMeanAndLeavesDaylightAlon
   const RotatedHeroMoments me = radiance_with_rotated_hero(e, ray, lambdas, 2000, 7);
   EXPECT_EQ(mc.mean, me.mean);
   EXPECT_EQ(mc.counters.collisions, me.counters.collisions);
+}
+
+// --- Shadow rays from the low, dense air are tracked against the residual of
+// a control extinction (residual_tracking_below_altitude_m): the same mean,
+// and less noise where the ground's sun NEE is most of the radiance (a view
+// of the ground from 0 m at noon; measured: the relative standard errors at
+// 430, 510, 590, 660 nm 0.0054, 0.0029, 0.0022, 0.0020 against 0.0073,
+// 0.0035, 0.0050, 0.0071 with the rule off, a third of the variance).
+TEST(IntegratorPhysics, LowShadowRaysByResidualTrackingKeepTheMeanWithLessNoise) {
+  const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun_at(30.0, 0.0, 0.0), Location{}, std::nullopt, 400.0, 700.0);
+  IntegratorOptions low, off;
+  off.residual_tracking_below_altitude_m = -1.0;
+  const Ray ray{scene.observer(), direction_from_zenith_azimuth(120.0 * kDegToRad, 1.0)};
+  const std::array<double, 4> lambdas = {430.0, 510.0, 590.0, 660.0};
+  const RotatedHeroMoments a = radiance_with_rotated_hero(VolumePathIntegrator(scene, low), ray, lambdas, 8000, 61);
+  const RotatedHeroMoments b = radiance_with_rotated_hero(VolumePathIntegrator(scene, off), ray, lambdas, 8000, 62);
+  EXPECT_EQ(a.counters.nonfinite + b.counters.nonfinite, 0u);
+  double var_a = 0.0, var_b = 0.0;
+  for (std::size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(a.mean[k], b.mean[k], 4.0 * std::hypot(a.se[k], b.se[k])) << lambdas[k] << " nm";
+    EXPECT_LT(a.se[k] / a.mean[k], b.se[k] / b.mean[k]) << lambdas[k] << " nm";
+    var_a += sqr(a.se[k] / a.mean[k]);
+    var_b += sqr(b.se[k] / b.mean[k]);
+  }
+  EXPECT_LT(var_a, 0.6 * var_b);
 }
 
 // --- White furnace: a non-absorbing atmosphere over a white ground under a
