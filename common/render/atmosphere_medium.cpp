@@ -101,7 +101,7 @@ void AtmosphereMedium::build_control_shells() {
         } else {
           k_min += wavelength_tables_.min_on(col.k_a, l0, l1);
         }
-        control_.table[i * bins + j] += rho_min * k_min;
+        control_.at(i, j) += rho_min * k_min;
       }
     }
   }
@@ -129,8 +129,9 @@ void AtmosphereMedium::build_shells() {
   const std::size_t bins = majorants_.bin_count();
   fine_.bins = coarse_.bins = bins;
   for (std::size_t i = 0; i <= majorants_.shell_count(); ++i) fine_.bottoms.push_back(majorants_.shell_bottom(i));
+  fine_.table.assign(fine_.shell_count() * bins, 0.0);
   for (std::size_t i = 0; i < majorants_.shell_count(); ++i)
-    for (std::size_t j = 0; j < bins; ++j) fine_.table.push_back(majorants_.sigma_maj(i, j) * (1.0 + 1e-9));
+    for (std::size_t j = 0; j < bins; ++j) fine_.at(i, j) = majorants_.sigma_maj(i, j) * (1.0 + 1e-9);
 
   std::vector<std::size_t> cuts{0};
   for (double target : {1000.0, 2000.0, 5000.0, 10000.0, 20000.0, 40000.0, 70000.0}) {
@@ -141,15 +142,16 @@ void AtmosphereMedium::build_shells() {
     if (best > cuts.back() && best < fine_.shell_count()) cuts.push_back(best);
   }
   cuts.push_back(fine_.shell_count());
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) coarse_.bottoms.push_back(fine_.bottoms[cuts[c]]);
+  coarse_.bottoms.push_back(fine_.bottoms.back());
+  coarse_.table.assign(coarse_.shell_count() * bins, 0.0);
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
-    coarse_.bottoms.push_back(fine_.bottoms[cuts[c]]);
     for (std::size_t j = 0; j < bins; ++j) {
       double m = 0.0;
-      for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) m = std::max(m, fine_.table[i * bins + j]);
-      coarse_.table.push_back(m);
+      for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) m = std::max(m, fine_.at(i, j));
+      coarse_.at(c, j) = m;
     }
   }
-  coarse_.bottoms.push_back(fine_.bottoms.back());
 }
 
 PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& lambda, const Sun* sun) const {
