@@ -11,7 +11,6 @@
 //   shells, bins    the majorant shells and the path's wavelength bins
 #pragma once
 #include <array>
-#include <optional>
 
 #include "common/render/atmosphere_medium.h"
 #include "common/render/recorded_shell_walk.h"
@@ -35,7 +34,7 @@ class LitDistanceSampler {
  private:
   const ShellMajorants& shells_;
   std::array<std::size_t, kWavelengthsPerPath> bins_;
-  std::array<std::optional<RecordedShellWalk>, 2> walks_;
+  std::array<RecordedShellWalk, 2> walks_;  // the first count_ are recorded
   int count_ = 0;
   SampledSpectrum tau_{0.0};
 };

@@ -161,11 +161,11 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       const ShellMajorants& shells = medium.fine_shells();
       const ShellTraversal walk(ray, radial, atmosphere.planet_radius_m(), shells.bottoms, extent.t_begin,
                                 extent.t_end);
-      std::optional<RecordedShellWalk> record;
+      RecordedShellWalk record;
       SampledSpectrum tau_maj(0.0);
       if (depth == 0 || forced) {
-        record.emplace(walk);
-        RecordedShellWalk::Replay replay = record->replay();
+        record.record(walk);
+        RecordedShellWalk::Replay replay = record.replay();
         tau_maj = majorant_optical_depth_along(replay, c.fine);
       }
       const double scale = depth == 0 ? camera_majorant_scale(tau_maj.max()) : 1.0;
@@ -245,8 +245,8 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         return sample_t_maj_along(segments, c.fine, medium, ray, path, sampler, mp, collide, scale, forced_tau);
       };
       SampledSpectrum T_maj;
-      if (record) {
-        RecordedShellWalk::Replay replay = record->replay();
+      if (record.recorded()) {
+        RecordedShellWalk::Replay replay = record.replay();
         T_maj = fly(replay);
       } else {
         ShellTraversal live = walk;
