@@ -86,23 +86,25 @@ void AtmosphereMedium::build_control_shells() {
   control_.bins = residual_.bins = bins;
   control_.bottoms = residual_.bottoms = fine_.bottoms;
   control_.table.assign(shells * bins, 0.0);
+  std::vector<double> k_min(bins);
   for (const Columns& col : columns_) {
+    // The smallest coefficient in each bin does not depend on the shell: once per bin.
+    for (std::size_t j = 0; j < bins; ++j) {
+      const double l0 = majorants_.lambda_min_nm() + majorants_.bin_width_nm() * static_cast<double>(j);
+      const double l1 = l0 + majorants_.bin_width_nm();
+      k_min[j] = wavelength_tables_.min_on(col.k_s, l0, l1);
+      if (col.ozone) {
+        double k_a_min = wavelength_tables_.min_on(col.k_a, l0, l1);
+        for (std::size_t k = 0; k < 5; ++k) k_a_min = std::min(k_a_min, wavelength_tables_.min_on(col.k_a + k, l0, l1));
+        k_min[j] += k_a_min;
+      } else {
+        k_min[j] += wavelength_tables_.min_on(col.k_a, l0, l1);
+      }
+    }
     for (std::size_t i = 0; i < shells; ++i) {
       const double rho_min = altitude_tables_.min_on(col.rho, fine_.bottoms[i], fine_.bottoms[i + 1]);
       if (!(rho_min > 0.0)) continue;
-      for (std::size_t j = 0; j < bins; ++j) {
-        const double l0 = majorants_.lambda_min_nm() + majorants_.bin_width_nm() * static_cast<double>(j);
-        const double l1 = l0 + majorants_.bin_width_nm();
-        double k_min = wavelength_tables_.min_on(col.k_s, l0, l1);
-        if (col.ozone) {
-          double k_a_min = wavelength_tables_.min_on(col.k_a, l0, l1);
-          for (std::size_t k = 0; k < 5; ++k) k_a_min = std::min(k_a_min, wavelength_tables_.min_on(col.k_a + k, l0, l1));
-          k_min += k_a_min;
-        } else {
-          k_min += wavelength_tables_.min_on(col.k_a, l0, l1);
-        }
-        control_.at(i, j) += rho_min * k_min;
-      }
+      for (std::size_t j = 0; j < bins; ++j) control_.at(i, j) += rho_min * k_min[j];
     }
   }
   residual_.table.resize(control_.table.size());
