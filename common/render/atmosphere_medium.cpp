@@ -177,15 +177,16 @@ void AtmosphereMedium::point(double h, const PathCoefficients& pc, MediumPoint* 
   out->sigma_a = SampledSpectrum(0.0);
   out->sigma_s = SampledSpectrum(0.0);
   if (h > atmosphere_.top_altitude_m()) {
-    for (std::size_t s = 0; s < scatterers_.size(); ++s) out->sigma_s_c[s] = SampledSpectrum(0.0);
+    for (std::size_t s = 0; s < scatterers_.size(); ++s) out->sigma_s_c[s] = SampledSpectrum(0.0).v;
     return;
   }
   h = std::max(h, 0.0);
   const UniformTableSet::Position at = altitude_tables_.locate(h);
   for (std::size_t s = 0; s < scatterers_.size(); ++s) {
     const Columns& col = columns_[static_cast<std::size_t>(scatterers_[s])];
-    out->sigma_s_c[s] = pc.k_of(col.k_s) * altitude_tables_.eval(at, col.rho);
-    out->sigma_s += out->sigma_s_c[s];
+    const SampledSpectrum sigma_s_c = pc.k_of(col.k_s) * altitude_tables_.eval(at, col.rho);
+    out->sigma_s_c[s] = sigma_s_c.v;
+    out->sigma_s += sigma_s_c;
   }
   for (int a : absorbers_) {
     const Columns& col = columns_[static_cast<std::size_t>(a)];

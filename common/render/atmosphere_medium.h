@@ -34,7 +34,11 @@ inline constexpr int kMaxScatterers = kMaxConstituents;
 // Coefficients at one point for the path's wavelengths.
 struct MediumPoint {
   SampledSpectrum sigma_a, sigma_s;
-  std::array<SampledSpectrum, kMaxScatterers> sigma_s_c;  // per scattering constituent
+  // Per scattering constituent, [scatterer][wavelength].  Plain arrays, left
+  // uninitialised: point() writes every scatterer's entry and nothing reads
+  // past them (a SampledSpectrum would zero all 16 on every MediumPoint made,
+  // a few per path and one per shadow ray).
+  std::array<std::array<double, kWavelengthsPerPath>, kMaxScatterers> sigma_s_c;
 };
 
 // The wavelength factors of every constituent at the path's wavelengths,
