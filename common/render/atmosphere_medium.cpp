@@ -24,14 +24,9 @@ constexpr int kWavelengthStepsPerBin = 16;
 
 }  // namespace
 
-double PathPhases::eval(int s, int i, double mu) const {
-  const Entry& e = entries_[static_cast<std::size_t>(s)];
-  return e.shared ? e.shared->eval(mu) : e.rayleigh[static_cast<std::size_t>(i)].eval(mu);
-}
-
-double PathPhases::sample_cos_theta(int s, double u) const {
-  const Entry& e = entries_[static_cast<std::size_t>(s)];
-  return e.shared ? e.shared->sample_cos_theta(u) : e.rayleigh[0].sample_cos_theta(u);
+double PathPhases::sample_cos_theta(int scatterer, double u) const {
+  const auto s = static_cast<std::size_t>(scatterer);
+  return shared_[s] ? shared_[s]->sample_cos_theta(u) : rayleigh(s, 0).sample_cos_theta(u);
 }
 
 AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm)
@@ -208,15 +203,15 @@ PathPhases AtmosphereMedium::phases(const SampledWavelengths& lambda) const {
   const auto& cs = atmosphere_.constituents();
   for (std::size_t s = 0; s < scatterers_.size(); ++s) {
     const Constituent& c = cs[static_cast<std::size_t>(scatterers_[s])];
-    auto& e = p.entries_[s];
     if (c.rayleigh_depolarization_from_bucholtz) {
-      e.shared = nullptr;
-      for (int i = 0; i < kWavelengthsPerPath; ++i) {
-        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[static_cast<std::size_t>(i)]);
-        e.rayleigh[static_cast<std::size_t>(i)] = RayleighPhase{rho_n, rho_n / (2.0 - rho_n)};
+      p.shared_[s] = nullptr;
+      for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) {
+        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[i]);
+        p.depolarization_[s][i] = rho_n;
+        p.gamma_[s][i] = rho_n / (2.0 - rho_n);
       }
     } else {
-      e.shared = &c.phase;
+      p.shared_[s] = &c.phase;
     }
   }
   return p;

@@ -90,17 +90,29 @@ struct ShellMajorants {
 // wavelength; others: the same function at every wavelength).
 class PathPhases {
  public:
-  double eval(int scatterer, int wavelength, double mu) const;
+  double eval(int scatterer, int wavelength, double mu) const {
+    const auto s = static_cast<std::size_t>(scatterer);
+    return shared_[s] ? shared_[s]->eval(mu) : rayleigh(s, static_cast<std::size_t>(wavelength)).eval(mu);
+  }
+  // Every wavelength's value at once: a wavelength-independent function is
+  // evaluated once (the same value eval() gives at each wavelength).
+  SampledSpectrum eval(int scatterer, double mu) const {
+    const auto s = static_cast<std::size_t>(scatterer);
+    if (shared_[s]) return SampledSpectrum(shared_[s]->eval(mu));
+    SampledSpectrum p;
+    for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) p.v[i] = rayleigh(s, i).eval(mu);
+    return p;
+  }
   double sample_cos_theta(int scatterer, double u) const;  // at the hero wavelength
   int count() const { return count_; }
 
  private:
   friend class AtmosphereMedium;
-  struct Entry {
-    const PhaseFunction* shared = nullptr;  // wavelength-independent
-    std::array<RayleighPhase, kWavelengthsPerPath> rayleigh{};  // used when shared == nullptr
-  };
-  std::array<Entry, kMaxScatterers> entries_{};
+  RayleighPhase rayleigh(std::size_t s, std::size_t i) const { return {depolarization_[s][i], gamma_[s][i]}; }
+  // Per scatterer; plain arrays left uninitialised past count_ (one
+  // PathPhases is made per path, and only the scatterers' entries are read).
+  std::array<const PhaseFunction*, kMaxScatterers> shared_;  // wavelength-independent, or nullptr: Rayleigh
+  std::array<std::array<double, kWavelengthsPerPath>, kMaxScatterers> depolarization_, gamma_;  // with nullptr
   int count_ = 0;
 };
 

@@ -52,10 +52,12 @@ RayExtent ray_extent(const RadialRay& ray, const Atmosphere& atmosphere) {
 // The mixture phase function p_i(mu) = sum_s sigma_s,s(l_i) p_s(mu; l_i) / sigma_s(l_i).
 SampledSpectrum mixture_phase(const MediumPoint& mp, const PathPhases& phases, double mu) {
   SampledSpectrum p(0.0);
-  for (int s = 0; s < phases.count(); ++s)
+  for (int s = 0; s < phases.count(); ++s) {
+    const SampledSpectrum p_s = phases.eval(s, mu);
     for (int i = 0; i < kWavelengthsPerPath; ++i)
       if (mp.sigma_s_c[static_cast<std::size_t>(s)][i] > 0.0)
-        p[i] += mp.sigma_s_c[static_cast<std::size_t>(s)][i] * phases.eval(s, i, mu);
+        p[i] += mp.sigma_s_c[static_cast<std::size_t>(s)][i] * p_s[i];
+  }
   return safe_div(p, mp.sigma_s);
 }
 
