@@ -75,14 +75,39 @@ std::size_t PiecewiseLinear::first_knot_above(double x) const {
 
 PiecewiseLinear PiecewiseLinear::constant(double value) { return PiecewiseLinear({0.0}, {value}); }
 
-double PiecewiseLinear::eval(double x) const {
-  if (x_.size() == 1) return (outside_ == Outside::kZero && x != x_[0]) ? 0.0 : y_[0];
-  if (x <= x_.front()) return (x < x_.front() && outside_ == Outside::kZero) ? 0.0 : y_.front();
-  if (x >= x_.back()) return (x > x_.back() && outside_ == Outside::kZero) ? 0.0 : y_.back();
-  // First knot strictly greater than x: x lies in [x_[i-1], x_[i]).
-  const std::size_t i = first_knot_above(x);
-  const double t = (x - x_[i - 1]) / (x_[i] - x_[i - 1]);
-  return y_[i - 1] + t * (y_[i] - y_[i - 1]);
+PiecewiseLinear::Location PiecewiseLinear::locate(double x) const {
+  Location at;
+  at.x = x;
+  if (x_.size() == 1) {
+    at.kind = Location::Kind::kSingle;
+  } else if (x <= x_.front()) {
+    at.kind = Location::Kind::kAtOrBelowFront;
+  } else if (x >= x_.back()) {
+    at.kind = Location::Kind::kAtOrAboveBack;
+  } else {
+    // First knot strictly greater than x: x lies in [x_[i-1], x_[i]).
+    at.kind = Location::Kind::kInside;
+    at.i = first_knot_above(x);
+    at.t = (x - x_[at.i - 1]) / (x_[at.i] - x_[at.i - 1]);
+  }
+  return at;
+}
+
+double PiecewiseLinear::eval(double x) const { return eval_at(locate(x)); }
+
+double PiecewiseLinear::eval_at(const Location& at) const {
+  const double x = at.x;
+  switch (at.kind) {
+    case Location::Kind::kSingle:
+      return (outside_ == Outside::kZero && x != x_[0]) ? 0.0 : y_[0];
+    case Location::Kind::kAtOrBelowFront:
+      return (x < x_.front() && outside_ == Outside::kZero) ? 0.0 : y_.front();
+    case Location::Kind::kAtOrAboveBack:
+      return (x > x_.back() && outside_ == Outside::kZero) ? 0.0 : y_.back();
+    case Location::Kind::kInside:
+      break;
+  }
+  return y_[at.i - 1] + at.t * (y_[at.i] - y_[at.i - 1]);
 }
 
 template <class Reduce>

@@ -23,6 +23,21 @@ class PiecewiseLinear {
   double eval(double x) const;
   double operator()(double x) const { return eval(x); }
 
+  // Where x lies among the knots.  Tables with the same knots (built from
+  // one abscissa column, like the CIE matching functions) can all be
+  // evaluated at x from one locate() with eval_at(): one search instead of
+  // one per table, and the same value as eval(x) for each.
+  struct Location {
+    enum class Kind { kSingle, kAtOrBelowFront, kAtOrAboveBack, kInside };
+    Kind kind = Kind::kSingle;
+    double x = 0.0;
+    std::size_t i = 0;  // kInside: x lies in [x_[i-1], x_[i])
+    double t = 0.0;     // kInside: (x - x_[i-1]) / (x_[i] - x_[i-1])
+  };
+  Location locate(double x) const;
+  // This table's value at a location found by it or by a table with the same knots.
+  double eval_at(const Location& at) const;
+
   // Exact maximum / minimum of the interpolant over [a, b] (a <= b): the
   // extremes of a piecewise-linear function lie at the ends or at knots.
   double max_on(double a, double b) const;

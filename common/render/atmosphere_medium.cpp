@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 
 #include "common/atmosphere/ozone.h"
@@ -23,24 +24,9 @@ constexpr int kWavelengthStepsPerBin = 16;
 
 }  // namespace
 
-UniformTable::UniformTable(double x0, double x1, int n, const std::function<double(double)>& f)
-    : x0_(x0), inv_step_(n > 1 ? (n - 1) / (x1 - x0) : 1.0) {
-  v_.resize(static_cast<std::size_t>(std::max(n, 1)));
-  for (int i = 0; i < n; ++i) {
-    // The last knot is x1 exactly (no round-off drift).
-    const double x = (i + 1 == n) ? x1 : x0 + (x1 - x0) * i / std::max(n - 1, 1);
-    v_[static_cast<std::size_t>(i)] = f(x);
-  }
-}
-
-double PathPhases::eval(int s, int i, double mu) const {
-  const Entry& e = entries_[static_cast<std::size_t>(s)];
-  return e.shared ? e.shared->eval(mu) : e.rayleigh[static_cast<std::size_t>(i)].eval(mu);
-}
-
-double PathPhases::sample_cos_theta(int s, double u) const {
-  const Entry& e = entries_[static_cast<std::size_t>(s)];
-  return e.shared ? e.shared->sample_cos_theta(u) : e.rayleigh[0].sample_cos_theta(u);
+double PathPhases::sample_cos_theta(int scatterer, double u) const {
+  const auto s = static_cast<std::size_t>(scatterer);
+  return shared_[s] ? shared_[s]->sample_cos_theta(u) : rayleigh(s, 0).sample_cos_theta(u);
 }
 
 AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_min_nm, double lambda_max_nm)
@@ -55,34 +41,33 @@ AtmosphereMedium::AtmosphereMedium(const Atmosphere& atmosphere, double lambda_m
   const int n_h = static_cast<int>(std::lround(top / altitude_step_)) + 1;
   const double l0 = majorants_.lambda_min_nm(), l1 = majorants_.lambda_max_nm();
   const int n_l = static_cast<int>(majorants_.bin_count()) * kWavelengthStepsPerBin + 1;
+  std::vector<std::function<double(double)>> of_altitude, of_wavelength;
   bool any_ozone = false;
   for (std::size_t c = 0; c < cs.size(); ++c) {
     const Constituent& con = cs[c];
-    Tables t;
-    t.rho = UniformTable(0.0, top, n_h, [&](double h) { return con.density.eval(h); });
-    t.k_s = UniformTable(l0, l1, n_l, [&](double l) { return con.k_scattering.eval(l, 0.0); });
-    t.ozone = con.k_absorption.is_ozone();
-    if (t.ozone) {
+    Columns col;
+    col.rho = of_altitude.size();
+    of_altitude.push_back([&con](double h) { return con.density.eval(h); });
+    col.k_s = of_wavelength.size();
+    of_wavelength.push_back([&con](double l) { return con.k_scattering.eval(l, 0.0); });
+    col.ozone = con.k_absorption.is_ozone();
+    col.k_a = of_wavelength.size();
+    if (col.ozone) {
       any_ozone = true;
       for (std::size_t k = 0; k < 5; ++k)
-        t.k_a_columns[k] = UniformTable(l0, l1, n_l, [&](double l) { return ozone::column_cross_section_m2(l, k); });
+        of_wavelength.push_back([k](double l) { return ozone::column_cross_section_m2(l, k); });
     } else {
-      t.k_a = UniformTable(l0, l1, n_l, [&](double l) { return con.k_absorption.eval(l, 0.0); });
+      of_wavelength.push_back([&con](double l) { return con.k_absorption.eval(l, 0.0); });
     }
-    tables_.push_back(std::move(t));
+    columns_.push_back(col);
     if (con.scatters()) scatterers_.push_back(static_cast<int>(c));
     if (con.absorbs()) absorbers_.push_back(static_cast<int>(c));
   }
-  if (any_ozone) temperature_ = UniformTable(0.0, top, n_h, us76::temperature_K);
+  temperature_column_ = of_altitude.size();
+  if (any_ozone) of_altitude.push_back(us76::temperature_K);
+  altitude_tables_ = UniformTableSet(0.0, top, n_h, of_altitude);
+  wavelength_tables_ = UniformTableSet(l0, l1, n_l, of_wavelength);
   build_control_shells();
-}
-
-double UniformTable::min_on(double a, double b) const {
-  double m = std::min(eval(a), eval(b));
-  const double last = static_cast<double>(v_.size() - 1);
-  const double u0 = std::max(0.0, std::ceil((a - x0_) * inv_step_)), u1 = std::min(last, std::floor((b - x0_) * inv_step_));
-  for (double u = u0; u <= u1; u += 1.0) m = std::min(m, v_[static_cast<std::size_t>(u)]);
-  return m;
 }
 
 // The control extinction of residual ratio tracking on the fine shells:
@@ -96,23 +81,25 @@ void AtmosphereMedium::build_control_shells() {
   control_.bins = residual_.bins = bins;
   control_.bottoms = residual_.bottoms = fine_.bottoms;
   control_.table.assign(shells * bins, 0.0);
-  for (const Tables& t : tables_) {
-    for (std::size_t i = 0; i < shells; ++i) {
-      const double rho_min = t.rho.min_on(fine_.bottoms[i], fine_.bottoms[i + 1]);
-      if (!(rho_min > 0.0)) continue;
-      for (std::size_t j = 0; j < bins; ++j) {
-        const double l0 = majorants_.lambda_min_nm() + majorants_.bin_width_nm() * static_cast<double>(j);
-        const double l1 = l0 + majorants_.bin_width_nm();
-        double k_min = t.k_s.min_on(l0, l1);
-        if (t.ozone) {
-          double k_a_min = t.k_a_columns[0].min_on(l0, l1);
-          for (const UniformTable& column : t.k_a_columns) k_a_min = std::min(k_a_min, column.min_on(l0, l1));
-          k_min += k_a_min;
-        } else {
-          k_min += t.k_a.min_on(l0, l1);
-        }
-        control_.table[i * bins + j] += rho_min * k_min;
+  std::vector<double> k_min(bins);
+  for (const Columns& col : columns_) {
+    // The smallest coefficient in each bin does not depend on the shell: once per bin.
+    for (std::size_t j = 0; j < bins; ++j) {
+      const double l0 = majorants_.lambda_min_nm() + majorants_.bin_width_nm() * static_cast<double>(j);
+      const double l1 = l0 + majorants_.bin_width_nm();
+      k_min[j] = wavelength_tables_.min_on(col.k_s, l0, l1);
+      if (col.ozone) {
+        double k_a_min = wavelength_tables_.min_on(col.k_a, l0, l1);
+        for (std::size_t k = 0; k < 5; ++k) k_a_min = std::min(k_a_min, wavelength_tables_.min_on(col.k_a + k, l0, l1));
+        k_min[j] += k_a_min;
+      } else {
+        k_min[j] += wavelength_tables_.min_on(col.k_a, l0, l1);
       }
+    }
+    for (std::size_t i = 0; i < shells; ++i) {
+      const double rho_min = altitude_tables_.min_on(col.rho, fine_.bottoms[i], fine_.bottoms[i + 1]);
+      if (!(rho_min > 0.0)) continue;
+      for (std::size_t j = 0; j < bins; ++j) control_.at(i, j) += rho_min * k_min[j];
     }
   }
   residual_.table.resize(control_.table.size());
@@ -139,8 +126,9 @@ void AtmosphereMedium::build_shells() {
   const std::size_t bins = majorants_.bin_count();
   fine_.bins = coarse_.bins = bins;
   for (std::size_t i = 0; i <= majorants_.shell_count(); ++i) fine_.bottoms.push_back(majorants_.shell_bottom(i));
+  fine_.table.assign(fine_.shell_count() * bins, 0.0);
   for (std::size_t i = 0; i < majorants_.shell_count(); ++i)
-    for (std::size_t j = 0; j < bins; ++j) fine_.table.push_back(majorants_.sigma_maj(i, j) * (1.0 + 1e-9));
+    for (std::size_t j = 0; j < bins; ++j) fine_.at(i, j) = majorants_.sigma_maj(i, j) * (1.0 + 1e-9);
 
   std::vector<std::size_t> cuts{0};
   for (double target : {1000.0, 2000.0, 5000.0, 10000.0, 20000.0, 40000.0, 70000.0}) {
@@ -151,15 +139,16 @@ void AtmosphereMedium::build_shells() {
     if (best > cuts.back() && best < fine_.shell_count()) cuts.push_back(best);
   }
   cuts.push_back(fine_.shell_count());
+  for (std::size_t c = 0; c + 1 < cuts.size(); ++c) coarse_.bottoms.push_back(fine_.bottoms[cuts[c]]);
+  coarse_.bottoms.push_back(fine_.bottoms.back());
+  coarse_.table.assign(coarse_.shell_count() * bins, 0.0);
   for (std::size_t c = 0; c + 1 < cuts.size(); ++c) {
-    coarse_.bottoms.push_back(fine_.bottoms[cuts[c]]);
     for (std::size_t j = 0; j < bins; ++j) {
       double m = 0.0;
-      for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) m = std::max(m, fine_.table[i * bins + j]);
-      coarse_.table.push_back(m);
+      for (std::size_t i = cuts[c]; i < cuts[c + 1]; ++i) m = std::max(m, fine_.at(i, j));
+      coarse_.at(c, j) = m;
     }
   }
-  coarse_.bottoms.push_back(fine_.bottoms.back());
 }
 
 PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& lambda, const Sun* sun) const {
@@ -170,17 +159,11 @@ PathCoefficients AtmosphereMedium::path_coefficients(const SampledWavelengths& l
     pc.sun_radiance[i] = sun ? sun->radiance(l) : 0.0;
     pc.ground_albedo[i] = atmosphere_.ground().albedo(l);
   }
-  for (std::size_t c = 0; c < tables_.size(); ++c) {
-    const Tables& t = tables_[c];
-    for (int i = 0; i < kWavelengthsPerPath; ++i) {
-      const double l = lambda.lambda_nm[static_cast<std::size_t>(i)];
-      pc.k_s[c][i] = t.k_s.eval(l);
-      if (t.ozone) {
-        for (std::size_t k = 0; k < 5; ++k) pc.k_a_columns[c][k][i] = t.k_a_columns[k].eval(l);
-      } else {
-        pc.k_a[c][i] = t.k_a.eval(l);
-      }
-    }
+  const std::size_t columns = wavelength_tables_.columns();
+  for (int i = 0; i < kWavelengthsPerPath; ++i) {
+    const auto w = static_cast<std::size_t>(i);
+    const UniformTableSet::Position at = wavelength_tables_.locate(lambda.lambda_nm[w]);
+    for (std::size_t col = 0; col < columns; ++col) pc.k[col][w] = wavelength_tables_.eval(at, col);
   }
   return pc;
 }
@@ -189,25 +172,27 @@ void AtmosphereMedium::point(double h, const PathCoefficients& pc, MediumPoint* 
   out->sigma_a = SampledSpectrum(0.0);
   out->sigma_s = SampledSpectrum(0.0);
   if (h > atmosphere_.top_altitude_m()) {
-    for (std::size_t s = 0; s < scatterers_.size(); ++s) out->sigma_s_c[s] = SampledSpectrum(0.0);
+    for (std::size_t s = 0; s < scatterers_.size(); ++s) out->sigma_s_c[s] = SampledSpectrum(0.0).v;
     return;
   }
   h = std::max(h, 0.0);
+  const UniformTableSet::Position at = altitude_tables_.locate(h);
   for (std::size_t s = 0; s < scatterers_.size(); ++s) {
-    const auto c = static_cast<std::size_t>(scatterers_[s]);
-    out->sigma_s_c[s] = pc.k_s[c] * tables_[c].rho.eval(h);
-    out->sigma_s += out->sigma_s_c[s];
+    const Columns& col = columns_[static_cast<std::size_t>(scatterers_[s])];
+    const SampledSpectrum sigma_s_c = pc.k_of(col.k_s) * altitude_tables_.eval(at, col.rho);
+    out->sigma_s_c[s] = sigma_s_c.v;
+    out->sigma_s += sigma_s_c;
   }
   for (int a : absorbers_) {
-    const auto c = static_cast<std::size_t>(a);
-    const double rho = tables_[c].rho.eval(h);
-    if (tables_[c].ozone) {
+    const Columns& col = columns_[static_cast<std::size_t>(a)];
+    const double rho = altitude_tables_.eval(at, col.rho);
+    if (col.ozone) {
       std::size_t k = 0;
       double t = 0.0;
-      ozone::temperature_bracket(temperature_.eval(h), &k, &t);
-      out->sigma_a += (pc.k_a_columns[c][k] * (1.0 - t) + pc.k_a_columns[c][k + 1] * t) * rho;
+      ozone::temperature_bracket(altitude_tables_.eval(at, temperature_column_), &k, &t);
+      out->sigma_a += (pc.k_of(col.k_a + k) * (1.0 - t) + pc.k_of(col.k_a + k + 1) * t) * rho;
     } else {
-      out->sigma_a += pc.k_a[c] * rho;
+      out->sigma_a += pc.k_of(col.k_a) * rho;
     }
   }
 }
@@ -218,15 +203,15 @@ PathPhases AtmosphereMedium::phases(const SampledWavelengths& lambda) const {
   const auto& cs = atmosphere_.constituents();
   for (std::size_t s = 0; s < scatterers_.size(); ++s) {
     const Constituent& c = cs[static_cast<std::size_t>(scatterers_[s])];
-    auto& e = p.entries_[s];
     if (c.rayleigh_depolarization_from_bucholtz) {
-      e.shared = nullptr;
-      for (int i = 0; i < kWavelengthsPerPath; ++i) {
-        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[static_cast<std::size_t>(i)]);
-        e.rayleigh[static_cast<std::size_t>(i)] = RayleighPhase{rho_n, rho_n / (2.0 - rho_n)};
+      p.shared_[s] = nullptr;
+      for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) {
+        const double rho_n = rayleigh::depolarization(lambda.lambda_nm[i]);
+        p.depolarization_[s][i] = rho_n;
+        p.gamma_[s][i] = rho_n / (2.0 - rho_n);
       }
     } else {
-      e.shared = &c.phase;
+      p.shared_[s] = &c.phase;
     }
   }
   return p;

@@ -17,12 +17,12 @@
 // inflated by 1e-9 relative against round-off at shell boundaries.
 #pragma once
 #include <array>
-#include <functional>
 #include <span>
 #include <vector>
 
 #include "common/atmosphere/atmosphere.h"
 #include "common/atmosphere/majorant_grid.h"
+#include "common/render/uniform_table_set.h"
 #include "common/spectrum/sampled_spectrum.h"
 #include "common/sun/sun.h"
 
@@ -34,29 +34,53 @@ inline constexpr int kMaxScatterers = kMaxConstituents;
 // Coefficients at one point for the path's wavelengths.
 struct MediumPoint {
   SampledSpectrum sigma_a, sigma_s;
-  std::array<SampledSpectrum, kMaxScatterers> sigma_s_c;  // per scattering constituent
+  // Per scattering constituent, [scatterer][wavelength].  Plain arrays, left
+  // uninitialised: point() writes every scatterer's entry and nothing reads
+  // past them (a SampledSpectrum would zero all 16 on every MediumPoint made,
+  // a few per path and one per shadow ray).
+  std::array<std::array<double, kWavelengthsPerPath>, kMaxScatterers> sigma_s_c;
 };
 
 // The wavelength factors of every constituent at the path's wavelengths,
 // and the other per-wavelength constants of a path.
 struct PathCoefficients {
+  // Up to 6 wavelength tables per constituent: k_s, and k_a or ozone's 5
+  // temperature columns.
+  static constexpr std::size_t kMaxColumns = 6 * kMaxConstituents;
+
   std::array<std::size_t, kWavelengthsPerPath> bins{};  // majorant bins
-  std::array<SampledSpectrum, kMaxConstituents> k_s, k_a;
-  std::array<std::array<SampledSpectrum, 5>, kMaxConstituents> k_a_columns;  // ozone temperature columns
   SampledSpectrum sun_radiance;   // inside the disk (the irradiance for a point sun)
   SampledSpectrum ground_albedo;
+  // The medium's wavelength tables at the path's wavelengths, by the
+  // medium's column numbers (AtmosphereMedium::Columns).  Plain arrays, left
+  // uninitialised past the medium's columns: only those are written and read.
+  std::array<std::array<double, kWavelengthsPerPath>, kMaxColumns> k;
+  SampledSpectrum k_of(std::size_t column) const {
+    SampledSpectrum s;
+    s.v = k[column];
+    return s;
+  }
 };
 
 // One set of majorant shells: boundaries (altitudes, K + 1 values) and
 // sigma_maj per (shell, wavelength bin), inflated by 1e-9 relative.
+//
+// Stored bin-major (each bin's shells side by side): a path reads its own
+// kWavelengthsPerPath bins shell after shell as it walks, so its values lie
+// in a few cache lines per bin (the Earth's 51 fine shells: 408 bytes)
+// instead of one cache line per (shell, wavelength) in a ~190 kB table.
 struct ShellMajorants {
   std::vector<double> bottoms;
-  std::vector<double> table;  // shell-major
+  std::vector<double> table;  // bin-major: table[bin * shell_count() + shell]
   std::size_t bins = 1;
   std::size_t shell_count() const { return bottoms.size() - 1; }
+  // The bin's values, shell by shell.
+  const double* bin_column(std::size_t bin) const { return table.data() + bin * shell_count(); }
+  double& at(std::size_t shell, std::size_t bin) { return table[bin * shell_count() + shell]; }
+  double at(std::size_t shell, std::size_t bin) const { return table[bin * shell_count() + shell]; }
   SampledSpectrum sigma_maj(std::size_t shell, const std::array<std::size_t, kWavelengthsPerPath>& b) const {
     SampledSpectrum m;
-    for (int i = 0; i < kWavelengthsPerPath; ++i) m[i] = table[shell * bins + b[static_cast<std::size_t>(i)]];
+    for (int i = 0; i < kWavelengthsPerPath; ++i) m[i] = at(shell, b[static_cast<std::size_t>(i)]);
     return m;
   }
 };
@@ -66,41 +90,30 @@ struct ShellMajorants {
 // wavelength; others: the same function at every wavelength).
 class PathPhases {
  public:
-  double eval(int scatterer, int wavelength, double mu) const;
+  double eval(int scatterer, int wavelength, double mu) const {
+    const auto s = static_cast<std::size_t>(scatterer);
+    return shared_[s] ? shared_[s]->eval(mu) : rayleigh(s, static_cast<std::size_t>(wavelength)).eval(mu);
+  }
+  // Every wavelength's value at once: a wavelength-independent function is
+  // evaluated once (the same value eval() gives at each wavelength).
+  SampledSpectrum eval(int scatterer, double mu) const {
+    const auto s = static_cast<std::size_t>(scatterer);
+    if (shared_[s]) return SampledSpectrum(shared_[s]->eval(mu));
+    SampledSpectrum p;
+    for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) p.v[i] = rayleigh(s, i).eval(mu);
+    return p;
+  }
   double sample_cos_theta(int scatterer, double u) const;  // at the hero wavelength
   int count() const { return count_; }
 
  private:
   friend class AtmosphereMedium;
-  struct Entry {
-    const PhaseFunction* shared = nullptr;  // wavelength-independent
-    std::array<RayleighPhase, kWavelengthsPerPath> rayleigh{};  // used when shared == nullptr
-  };
-  std::array<Entry, kMaxScatterers> entries_{};
+  RayleighPhase rayleigh(std::size_t s, std::size_t i) const { return {depolarization_[s][i], gamma_[s][i]}; }
+  // Per scatterer; plain arrays left uninitialised past count_ (one
+  // PathPhases is made per path, and only the scatterers' entries are read).
+  std::array<const PhaseFunction*, kMaxScatterers> shared_;  // wavelength-independent, or nullptr: Rayleigh
+  std::array<std::array<double, kWavelengthsPerPath>, kMaxScatterers> depolarization_, gamma_;  // with nullptr
   int count_ = 0;
-};
-
-// A function tabulated at x0 + i step, i = 0..n-1, linear in between, held at the ends.
-class UniformTable {
- public:
-  UniformTable() = default;
-  UniformTable(double x0, double x1, int n, const std::function<double(double)>& f);
-  double eval(double x) const {
-    double u = (x - x0_) * inv_step_;
-    if (!(u > 0.0)) return v_.front();
-    const double last = static_cast<double>(v_.size() - 1);
-    if (u >= last) return v_.back();
-    const auto i = static_cast<std::size_t>(u);
-    u -= static_cast<double>(i);
-    return v_[i] + u * (v_[i + 1] - v_[i]);
-  }
-  // The smallest value on [a, b]: at the ends or at a knot in between (the
-  // function is linear between knots).
-  double min_on(double a, double b) const;
-
- private:
-  double x0_ = 0.0, inv_step_ = 1.0;
-  std::vector<double> v_{0.0};
 };
 
 class AtmosphereMedium {
@@ -137,10 +150,11 @@ class AtmosphereMedium {
   void build_shells();
   void build_control_shells();
 
-  struct Tables {
-    UniformTable rho;                        // density on the altitude grid
-    UniformTable k_s, k_a;                   // per unit density, on the wavelength grid
-    std::array<UniformTable, 5> k_a_columns; // ozone: per temperature column
+  // A constituent's columns in the set of altitude tables (its density) and
+  // in the set of wavelength tables (k_s, then k_a or ozone's 5 columns).
+  struct Columns {
+    std::size_t rho = 0;
+    std::size_t k_s = 0, k_a = 0;  // ozone: k_a is its first temperature column
     bool ozone = false;
   };
 
@@ -148,8 +162,13 @@ class AtmosphereMedium {
   double altitude_step_;
   MajorantGrid majorants_;
   ShellMajorants fine_, coarse_, control_, residual_;
-  std::vector<Tables> tables_;   // per constituent
-  UniformTable temperature_;     // US76 T(h), for ozone
+  // Every constituent's density, then (with ozone) US76 T(h), on the
+  // uniform altitude grid (<= 25 m steps); every wavelength factor on the
+  // uniform wavelength grid (1/16 of a majorant bin).  One set each: a
+  // collision locates its altitude once, a path each wavelength once.
+  UniformTableSet altitude_tables_, wavelength_tables_;
+  std::vector<Columns> columns_;  // per constituent
+  std::size_t temperature_column_ = 0;
   std::vector<int> scatterers_;  // constituent indices that scatter
   std::vector<int> absorbers_;   // constituent indices that absorb
 };

@@ -38,8 +38,7 @@ namespace skyfarm {
 // sample_t_maj_along does the same along any walk of the ray's shell segments
 // (a ShellTraversal, or the replay of a RecordedShellWalk when the segments
 // were already walked for majorant_optical_depth), with the majorants of the
-// path's wavelengths from `majorants` (PathMajorants, or TableMajorants:
-// path_majorants.h).
+// path's wavelengths from `majorants` (PathMajorants: path_majorants.h).
 template <class Walk, class Majorants, class Callback>
 SampledSpectrum sample_t_maj_along(Walk& walk, const Majorants& majorants, const AtmosphereMedium& medium,
                                    const Ray& ray, const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
@@ -80,7 +79,7 @@ SampledSpectrum sample_t_maj(const AtmosphereMedium& medium, const ShellMajorant
                              const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
                              Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
   ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), shells.bottoms, t_begin, t_end);
-  return sample_t_maj_along(walk, TableMajorants{shells, path.bins}, medium, ray, path, sampler, point,
+  return sample_t_maj_along(walk, PathMajorants(shells, path.bins), medium, ray, path, sampler, point,
                             std::forward<Callback>(callback), majorant_scale, forced_tau);
 }
 
@@ -109,7 +108,7 @@ inline SampledSpectrum majorant_optical_depth(const AtmosphereMedium& medium, co
                                               const Ray& ray, double t_begin, double t_end,
                                               const std::array<std::size_t, kWavelengthsPerPath>& bins) {
   ShellTraversal walk(ray, medium.atmosphere().planet_radius_m(), shells.bottoms, t_begin, t_end);
-  return majorant_optical_depth_along(walk, TableMajorants{shells, bins});
+  return majorant_optical_depth_along(walk, PathMajorants(shells, bins));
 }
 
 }  // namespace skyfarm

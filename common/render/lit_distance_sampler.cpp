@@ -8,13 +8,13 @@ namespace skyfarm {
 LitDistanceSampler::LitDistanceSampler(const Ray& ray, const SunlitIntervals& set, double R,
                                        const ShellMajorants& shells,
                                        const std::array<std::size_t, kWavelengthsPerPath>& bins)
-    : shells_(shells), bins_(bins), count_(set.count) {
+    : majorants_(shells, bins), count_(set.count) {
   for (int k = 0; k < count_; ++k) {
     const auto [a, b] = set.lit[static_cast<std::size_t>(k)];
-    walks_[static_cast<std::size_t>(k)].emplace(ShellTraversal(ray, R, shells.bottoms, a, b));
-    auto walk = walks_[static_cast<std::size_t>(k)]->replay();
+    walks_[static_cast<std::size_t>(k)].record(ShellTraversal(ray, R, shells.bottoms, a, b));
+    auto walk = walks_[static_cast<std::size_t>(k)].replay();
     ShellSegment seg;
-    while (walk.next(&seg)) tau_ += shells_.sigma_maj(seg.shell, bins_) * (seg.t1 - seg.t0);
+    while (walk.next(&seg)) tau_ += majorants_.sigma_maj(seg.shell) * (seg.t1 - seg.t0);
   }
 }
 
@@ -25,10 +25,10 @@ bool LitDistanceSampler::sample(double u, double* t) const {
   const double mass = -std::expm1(-tau_[0]);
   double target = std::min(tau_[0], -std::log1p(-u * mass));
   for (int k = 0; k < count_; ++k) {
-    auto walk = walks_[static_cast<std::size_t>(k)]->replay();
+    auto walk = walks_[static_cast<std::size_t>(k)].replay();
     ShellSegment seg;
     while (walk.next(&seg)) {
-      const double m = shells_.sigma_maj(seg.shell, bins_)[0];
+      const double m = majorants_.sigma_maj(seg.shell)[0];
       const double tau_seg = m * (seg.t1 - seg.t0);
       if (m > 0.0 && target <= tau_seg) {
         *t = seg.t0 + target / m;
@@ -43,10 +43,10 @@ bool LitDistanceSampler::sample(double u, double* t) const {
 SampledSpectrum LitDistanceSampler::pdf(double t) const {
   SampledSpectrum tau_t(0.0);
   for (int k = 0; k < count_; ++k) {
-    auto walk = walks_[static_cast<std::size_t>(k)]->replay();
+    auto walk = walks_[static_cast<std::size_t>(k)].replay();
     ShellSegment seg;
     while (walk.next(&seg)) {
-      const SampledSpectrum m = shells_.sigma_maj(seg.shell, bins_);
+      const SampledSpectrum m = majorants_.sigma_maj(seg.shell);
       if (t >= seg.t0 && t <= seg.t1) {
         tau_t += m * (t - seg.t0);
         SampledSpectrum p;

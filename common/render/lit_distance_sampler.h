@@ -11,9 +11,9 @@
 //   shells, bins    the majorant shells and the path's wavelength bins
 #pragma once
 #include <array>
-#include <optional>
 
 #include "common/render/atmosphere_medium.h"
+#include "common/render/path_majorants.h"
 #include "common/render/recorded_shell_walk.h"
 #include "common/render/sunlit_intervals.h"
 
@@ -33,9 +33,8 @@ class LitDistanceSampler {
   SampledSpectrum pdf(double t) const;
 
  private:
-  const ShellMajorants& shells_;
-  std::array<std::size_t, kWavelengthsPerPath> bins_;
-  std::array<std::optional<RecordedShellWalk>, 2> walks_;
+  PathMajorants majorants_;  // the path's bins of the shells
+  std::array<RecordedShellWalk, 2> walks_;  // the first count_ are recorded
   int count_ = 0;
   SampledSpectrum tau_{0.0};
 };

@@ -23,8 +23,18 @@ class RecordedShellWalk {
  public:
   static constexpr std::size_t kCapacity = 160;
 
+  // Nothing recorded (recorded() is false).  Cheaper than an empty
+  // std::optional<RecordedShellWalk>, whose constructor (GCC 12) zero-fills
+  // the ~4 kB of storage.
+  RecordedShellWalk() {}  // NOLINT: user-provided, so the storage stays uninitialised
   // Walks `walk` as far as the record holds.
-  explicit RecordedShellWalk(const ShellTraversal& walk) : rest_(walk) {
+  explicit RecordedShellWalk(const ShellTraversal& walk) { record(walk); }
+
+  // Records `walk` (in place of any earlier record).
+  void record(const ShellTraversal& walk) {
+    rest_ = walk;
+    count_ = 0;
+    recorded_ = true;
     ShellSegment s;
     while (count_ < kCapacity && rest_.next(&s)) {
       t0_[count_] = s.t0;
@@ -33,6 +43,7 @@ class RecordedShellWalk {
       ++count_;
     }
   }
+  bool recorded() const { return recorded_; }
 
   // The recorded segments in order, then those of the walk past the record.
   class Replay {
@@ -61,6 +72,7 @@ class RecordedShellWalk {
   std::array<double, kCapacity> t0_, t1_;
   std::array<std::size_t, kCapacity> shell_;
   std::size_t count_ = 0;
+  bool recorded_ = false;
   ShellTraversal rest_;  // the walk after the last recorded segment
 };
 

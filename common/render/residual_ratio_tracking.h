@@ -33,6 +33,7 @@
 
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/atmosphere_medium.h"
+#include "common/render/path_majorants.h"
 #include "common/render/shell_traversal.h"
 #include "common/sampling/sampler.h"
 
@@ -47,7 +48,8 @@ inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medi
                                                     const PathCoefficients& path, Sampler& sampler,
                                                     std::uint64_t* collisions, bool roulette) {
   const ShellMajorants& residual = medium.residual_shells();
-  const ShellMajorants& control = medium.control_shells();
+  // The path's columns of both tables, found once (not per shell crossed).
+  const PathMajorants residual_of(residual, path.bins), control_of(medium.control_shells(), path.bins);
   const double R = medium.atmosphere().planet_radius_m();
   TrackedTransmittance out;
   SampledSpectrum tau_r(0.0), tau_c(0.0);  // since the last collision
@@ -56,8 +58,8 @@ inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medi
   ShellTraversal walk(ray, radial, R, residual.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum mu_r = residual.sigma_maj(segment.shell, path.bins);
-    const SampledSpectrum sigma_c = control.sigma_maj(segment.shell, path.bins);
+    const SampledSpectrum mu_r = residual_of.sigma_maj(segment.shell);
+    const SampledSpectrum sigma_c = control_of.sigma_maj(segment.shell);
     double t = segment.t0;
     while (true) {
       const double tau_rest = mu_r[0] * (segment.t1 - t);

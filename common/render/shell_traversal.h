@@ -28,6 +28,8 @@ struct ShellSegment {
 
 class ShellTraversal {
  public:
+  // A walk of nothing (next() is false at once).
+  ShellTraversal() : done_(true) {}
   // shell_bottoms: the altitudes h_0 = 0 < h_1 < ... < h_K = top (K + 1 values).
   // The walk covers [t_begin, t_end] of the ray; the caller makes t_begin a
   // point inside the atmosphere (or its entry point) and t_end the ground hit,
@@ -48,12 +50,12 @@ class ShellTraversal {
   bool roots(double rho, double* t_near, double* t_far) const;
 
   Ray ray_;
-  double R_;
+  double R_ = 0.0;
   std::span<const double> h_;
-  double t_, t_end_, t_turn_;
-  double r0_, b_, l_;  // |o|, o.d, closest approach of the line to the centre
-  std::size_t shell_;
-  bool inbound_;
+  double t_ = 0.0, t_end_ = 0.0, t_turn_ = 0.0;
+  double r0_ = 0.0, b_ = 0.0, l_ = 0.0;  // |o|, o.d, closest approach of the line to the centre
+  std::size_t shell_ = 0;
+  bool inbound_ = false;
   bool done_ = false;
 };
 

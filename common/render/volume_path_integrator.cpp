@@ -52,10 +52,12 @@ RayExtent ray_extent(const RadialRay& ray, const Atmosphere& atmosphere) {
 // The mixture phase function p_i(mu) = sum_s sigma_s,s(l_i) p_s(mu; l_i) / sigma_s(l_i).
 SampledSpectrum mixture_phase(const MediumPoint& mp, const PathPhases& phases, double mu) {
   SampledSpectrum p(0.0);
-  for (int s = 0; s < phases.count(); ++s)
+  for (int s = 0; s < phases.count(); ++s) {
+    const SampledSpectrum p_s = phases.eval(s, mu);
     for (int i = 0; i < kWavelengthsPerPath; ++i)
       if (mp.sigma_s_c[static_cast<std::size_t>(s)][i] > 0.0)
-        p[i] += mp.sigma_s_c[static_cast<std::size_t>(s)][i] * phases.eval(s, i, mu);
+        p[i] += mp.sigma_s_c[static_cast<std::size_t>(s)][i] * p_s[i];
+  }
   return safe_div(p, mp.sigma_s);
 }
 
@@ -161,11 +163,11 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       const ShellMajorants& shells = medium.fine_shells();
       const ShellTraversal walk(ray, radial, atmosphere.planet_radius_m(), shells.bottoms, extent.t_begin,
                                 extent.t_end);
-      std::optional<RecordedShellWalk> record;
+      RecordedShellWalk record;
       SampledSpectrum tau_maj(0.0);
       if (depth == 0 || forced) {
-        record.emplace(walk);
-        RecordedShellWalk::Replay replay = record->replay();
+        record.record(walk);
+        RecordedShellWalk::Replay replay = record.replay();
         tau_maj = majorant_optical_depth_along(replay, c.fine);
       }
       const double scale = depth == 0 ? camera_majorant_scale(tau_maj.max()) : 1.0;
@@ -245,8 +247,8 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         return sample_t_maj_along(segments, c.fine, medium, ray, path, sampler, mp, collide, scale, forced_tau);
       };
       SampledSpectrum T_maj;
-      if (record) {
-        RecordedShellWalk::Replay replay = record->replay();
+      if (record.recorded()) {
+        RecordedShellWalk::Replay replay = record.replay();
         T_maj = fly(replay);
       } else {
         ShellTraversal live = walk;

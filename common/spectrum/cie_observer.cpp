@@ -23,9 +23,11 @@ const CieObserver& cie1931_observer() {
   return observer;
 }
 
+// The three functions share their knots (one wavelength column): one search.
 Xyz cie1931_cmf(double lambda_nm) {
   const CieObserver& o = cie1931_observer();
-  return {o.xbar(lambda_nm), o.ybar(lambda_nm), o.zbar(lambda_nm)};
+  const PiecewiseLinear::Location at = o.ybar.locate(lambda_nm);
+  return {o.xbar.eval_at(at), o.ybar.eval_at(at), o.zbar.eval_at(at)};
 }
 
 double cie1931_ybar(double lambda_nm) { return cie1931_observer().ybar(lambda_nm); }

@@ -10,7 +10,7 @@
 namespace skyfarm {
 
 struct CieObserver {
-  PiecewiseLinear xbar, ybar, zbar;  // dimensionless, λ in nm
+  PiecewiseLinear xbar, ybar, zbar;  // dimensionless, λ in nm; the same knots (cie1931_cmf relies on it)
   double ybar_integral_nm;           // ∫ ȳ(λ) dλ over 360–830 nm, nm
 };
 

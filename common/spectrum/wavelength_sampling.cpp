@@ -1,7 +1,9 @@
 #include "common/spectrum/wavelength_sampling.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -17,10 +19,15 @@ void check_range(double min_nm, double max_nm, const char* who) {
                                 ", " + std::to_string(max_nm) + "] nm must be finite with min < max");
 }
 
+// The largest double below a positive finite x: std::nextafter(x, 0.0)
+// (one step down in the bit pattern), but constexpr: nextafter is a library
+// call, and rotated_strata ran five per path.
+constexpr double double_below(double x) { return std::bit_cast<double>(std::bit_cast<std::uint64_t>(x) - 1); }
+
 // u clamped into [0, 1) (the largest double below 1 is 1 − 2⁻⁵³); NaN → 0.
 double clamp_unit(double u) {
   if (!(u > 0.0)) return 0.0;
-  return std::min(u, std::nextafter(1.0, 0.0));
+  return std::min(u, double_below(1.0));
 }
 
 // log cosh x = |x| + log(1 + e^{−2|x|}) − log 2, without overflow for any x.
@@ -47,6 +54,12 @@ double sigma(double z) { return 1.0 / (1.0 + std::exp(-z)); }
 // SampledWavelengths::SampleVisible), computed stratum by stratum.
 std::array<double, kWavelengthsPerPath> rotated_strata(double u) {
   constexpr double n = kWavelengthsPerPath;
+  // The largest double below each stratum's top (k + 1)/N.
+  constexpr std::array<double, kWavelengthsPerPath> stratum_tops = [] {
+    std::array<double, kWavelengthsPerPath> tops{};
+    for (int k = 0; k < kWavelengthsPerPath; ++k) tops[static_cast<std::size_t>(k)] = double_below((k + 1) / n);
+    return tops;
+  }();
   const double s = clamp_unit(u) * n;                  // exact: N is a power of two
   const int j = std::min(static_cast<int>(s), kWavelengthsPerPath - 1);
   const double f = s - j;                              // exact (Sterbenz), f ∈ [0, 1)
@@ -55,7 +68,7 @@ std::array<double, kWavelengthsPerPath> rotated_strata(double u) {
     const int k = (j + i) % kWavelengthsPerPath;
     // k + f may round up to k + 1 when f is within an ulp of 1: keep u_i in
     // its stratum [k/N, (k+1)/N).
-    ui[static_cast<std::size_t>(i)] = std::min((k + f) / n, std::nextafter((k + 1) / n, 0.0));
+    ui[static_cast<std::size_t>(i)] = std::min((k + f) / n, stratum_tops[static_cast<std::size_t>(k)]);
   }
   return ui;
 }

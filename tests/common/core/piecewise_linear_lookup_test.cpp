@@ -93,5 +93,34 @@ TEST(PiecewiseLinearLookup, UniformGridWithKnotsOnBucketEdgesMatchesBinarySearch
   EXPECT_TRUE(same_bits(g.eval(555.25), reference_eval(x, y, true, 555.25)));
 }
 
+// cie1931_cmf locates the wavelength once (in ybar) for all three functions:
+// each must still be, bit for bit, its own table's binary-search value.
+TEST(PiecewiseLinearLookup, OneLocationServesEveryTableWithTheSameKnots) {
+  std::mt19937_64 rng(11);
+  const CieObserver& o = cie1931_observer();
+  const std::vector<double> x(o.ybar.x().begin(), o.ybar.x().end());
+  ASSERT_TRUE(std::equal(x.begin(), x.end(), o.xbar.x().begin(), o.xbar.x().end()));
+  ASSERT_TRUE(std::equal(x.begin(), x.end(), o.zbar.x().begin(), o.zbar.x().end()));
+  const std::vector<double> xs(o.xbar.y().begin(), o.xbar.y().end()), ys(o.ybar.y().begin(), o.ybar.y().end()),
+      zs(o.zbar.y().begin(), o.zbar.y().end());
+  int mismatches = 0;
+  for (double v : probe_points(x, rng)) {
+    const Xyz cmf = cie1931_cmf(v);
+    if (!same_bits(cmf.x, reference_eval(x, xs, true, v))) ++mismatches;
+    if (!same_bits(cmf.y, reference_eval(x, ys, true, v))) ++mismatches;
+    if (!same_bits(cmf.z, reference_eval(x, zs, true, v))) ++mismatches;
+  }
+  EXPECT_EQ(mismatches, 0);
+  // A one-knot table and a clamped one read the same location kinds right.
+  const PiecewiseLinear one = PiecewiseLinear::constant(2.0);
+  EXPECT_EQ(one.eval_at(one.locate(-7.0)), 2.0);
+  const PiecewiseLinear clamp({1.0, 2.0}, {10.0, 20.0});
+  const PiecewiseLinear zero({1.0, 2.0}, {-1.0, -2.0}, PiecewiseLinear::Outside::kZero);
+  for (double v : {0.5, 1.0, 1.25, 2.0, 3.0}) {
+    EXPECT_TRUE(same_bits(clamp.eval_at(zero.locate(v)), clamp.eval(v))) << v;
+    EXPECT_TRUE(same_bits(zero.eval_at(clamp.locate(v)), zero.eval(v))) << v;
+  }
+}
+
 }  // namespace
 }  // namespace skyfarm

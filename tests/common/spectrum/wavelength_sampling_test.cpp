@@ -136,6 +136,19 @@ TEST(WavelengthSampling, RotatedStrataOnePerQuarter) {
   }
 }
 
+// Just below a quarter, u_1..u_3 round up to their stratum's top and are held
+// at the largest double below it, exactly std::nextafter's.
+TEST(WavelengthSampling, RotatedStrataHeldJustBelowEachQuartersTop) {
+  const auto ui = rotated_strata(std::nextafter(0.25, 0.0));
+  EXPECT_EQ(ui[0], std::nextafter(0.25, 0.0));
+  EXPECT_EQ(ui[1], std::nextafter(0.5, 0.0));
+  EXPECT_EQ(ui[2], std::nextafter(0.75, 0.0));
+  EXPECT_EQ(ui[3], std::nextafter(1.0, 0.0));
+  // u at or above 1 is clamped to the largest double below 1.
+  EXPECT_EQ(rotated_strata(1.0)[0], std::nextafter(1.0, 0.0));
+  EXPECT_EQ(rotated_strata(7.0)[0], std::nextafter(1.0, 0.0));
+}
+
 // Each of the 4 wavelengths lies in its own quarter of the CDF and inside the range.
 TEST(WavelengthSampling, FourWavelengthsStratifiedInsideRange) {
   std::mt19937_64 rng(2);
