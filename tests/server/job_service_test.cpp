@@ -323,14 +323,14 @@ namespace {
 // stops by the same rule, whatever order the results arrive in.
 TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {
   // Looking away from the sun: the estimate falls as 1/sqrt(samples)
-  // (0.16 after one pass of 16, 0.12 at 32, 0.097 at 48), so 0.1 stops
+  // (0.129 after one pass of 16, 0.092 at 32, 0.075 at 48), so 0.08 stops
   // after 3 of the 16 passes, as `skyfarm-worker render` does.
   constexpr const char* kTargeted = R"({
     "sun": {"zenith_deg": 50, "azimuth_deg": 140},
     "camera": {"projection": "perspective", "width": 40, "height": 20, "yaw_deg": 320, "pitch_deg": 10,
                "fov_deg": 60},
     "spectral": {"batches": 2},
-    "quality": {"samples_per_pixel": 256, "target_relative_error": 0.1},
+    "quality": {"samples_per_pixel": 256, "target_relative_error": 0.08},
     "output": {"half": false},
     "seed": 5
   })";
@@ -343,8 +343,8 @@ TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {
   ASSERT_EQ(s["state"], "done");
   EXPECT_EQ(s["stopped_by"], "target_error");
   EXPECT_LT(s["progress"]["samples_per_pixel"].get<int>(), 256);
-  EXPECT_LE(s["error"]["estimated_relative_rms"].get<double>(), 0.1);
-  EXPECT_EQ(s["progress"]["samples_per_pixel"], 48);
+  EXPECT_LE(s["error"]["estimated_relative_rms"].get<double>(), 0.08);
+  EXPECT_EQ(s["progress"]["samples_per_pixel"], 48) << s["error"]["history"].dump();
   // The history falls pass after pass, the last entry at the target.
   const auto& h = s["error"]["history"];
   ASSERT_GE(h.size(), 2u);
