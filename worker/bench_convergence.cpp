@@ -201,12 +201,14 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       options.explicit_single_scattering = true;
     else if (args[i] == "--passes" && i + 1 < args.size()) passes = std::max(2, std::atoi(args[++i].c_str()));
     else if (args[i] == "--seed" && i + 1 < args.size()) seed = std::atoi(args[++i].c_str());
+    else if (args[i] == "--max-camera-scale" && i + 1 < args.size())
+      options.max_camera_majorant_scale = std::atof(args[++i].c_str());
     else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size())
       options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
-                   "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W]\n";
+                   "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n";
       return 2;
     }
   }
