@@ -125,9 +125,11 @@ void read_quality(const Fields& top, QualitySpec& q) {
   if (!v || !expect_object(*v, top.path_of("quality"), top.errors())) return;
   Fields f(*v, top.path_of("quality"), top.errors());
   f.allow_only({"samples_per_pixel", "target_relative_error", "time_limit_s"});
-  f.integer("samples_per_pixel", 1, 1048576, q.samples_per_pixel);
+  f.integer("samples_per_pixel", 1, QualitySpec::kMaxSamplesPerPixel, q.samples_per_pixel);
   f.optional_number("target_relative_error", Range::open_closed(0, 1), q.target_relative_error);
   f.optional_number("time_limit_s", Range::open_closed(0, 604800), q.time_limit_s);
+  if (!v->contains("samples_per_pixel") && (q.target_relative_error || q.time_limit_s))
+    q.samples_per_pixel = QualitySpec::kMaxSamplesPerPixel;
 }
 
 // --- "output"

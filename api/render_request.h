@@ -32,9 +32,14 @@ struct SpectralSpec {
   int batches = 1;
 };
 
-// "quality": when a render stops (whichever comes first).
+// "quality": when a render stops (whichever comes first).  Without
+// samples_per_pixel, a request that gives a target error or a time limit has
+// no sample cap below kMaxSamplesPerPixel ("1 % in at most 2 minutes" runs
+// until one of those); one that gives neither gets 64.
 struct QualitySpec {
-  int samples_per_pixel = 64;
+  static constexpr int kDefaultSamplesPerPixel = 64;
+  static constexpr int kMaxSamplesPerPixel = 1048576;
+  int samples_per_pixel = kDefaultSamplesPerPixel;
   std::optional<double> target_relative_error;  // image relative RMS error
   std::optional<double> time_limit_s;
 };

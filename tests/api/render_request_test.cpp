@@ -182,6 +182,24 @@ TEST(RenderRequestDefaults, MinimalRequestGetsEveryDefault) {
   EXPECT_EQ(r.priority, 50);
 }
 
+// "1 % in at most 2 minutes": a target error or a time limit without a sample
+// count is not capped at the default 64 samples.
+TEST(RenderRequestDefaults, TargetOrTimeLimitWithoutSamplesHasNoSampleCap) {
+  EXPECT_EQ(parse_render_request(with(R"("quality": {"target_relative_error": 0.01})")).quality.samples_per_pixel,
+            QualitySpec::kMaxSamplesPerPixel);
+  EXPECT_EQ(parse_render_request(with(R"("quality": {"time_limit_s": 120})")).quality.samples_per_pixel,
+            QualitySpec::kMaxSamplesPerPixel);
+  EXPECT_EQ(parse_render_request(with(R"("quality": {"target_relative_error": 0.01, "time_limit_s": 120})"))
+                .quality.samples_per_pixel,
+            QualitySpec::kMaxSamplesPerPixel);
+  EXPECT_EQ(parse_render_request(with(R"("quality": {"target_relative_error": 0.01, "samples_per_pixel": 32})"))
+                .quality.samples_per_pixel,
+            32);
+  EXPECT_EQ(parse_render_request(with(R"("quality": {"target_relative_error": null})")).quality.samples_per_pixel,
+            64);
+  EXPECT_EQ(parse_render_request(with(R"("quality": {})")).quality.samples_per_pixel, 64);
+}
+
 TEST(RenderRequestDefaults, SizeAndFieldOfViewFollowTheProjection) {
   auto camera = [](const std::string& c) {
     return parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 0}, "camera": )" + c + "}").camera;
