@@ -64,7 +64,8 @@ class TileMerger {
 
   // Resolves every tile into `image` (sizes must match).
   void resolve(Image* image) const;
-  // sqrt(sum_i var(Y_i) / sum_i Y_i^2) over pixels with an estimate, or
+  // ErrorSums::relative_rms: sqrt(sum_i var(Y_i) / sum_i Y_i^2) with the true
+  // sum Y^2 estimated from the noisy means, over pixels with an estimate, or
   // nullopt; `excluded` are the sun disk's pixels (render/sun_pixels.h).
   std::optional<double> estimated_relative_rms(const std::vector<std::uint32_t>& excluded = {}) const;
   // The sums behind it, with the count of traced pixels that have too few

@@ -10,9 +10,9 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_setup.h"
+#include "common/film/error_estimate.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
-#include "common/film/error_estimate.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -83,9 +83,9 @@ double true_error(const std::vector<double>& Y, const std::vector<double>& ref, 
   return den > 0.0 ? std::sqrt(num / den) : 0.0;
 }
 
-// The renderer's own estimate over the same pixels: sqrt(sum var(Y_i) / sum Y_i^2).
+// The renderer's own estimate over the same pixels (ErrorSums::relative_rms).
 double estimated_error(const std::vector<FilmTile>& film, const std::vector<bool>& keep) {
-  double var_sum = 0.0, y2 = 0.0;
+  ErrorSums sums;
   for (const auto& tile : film)
     for (int y = tile.y0(); y < tile.y0() + tile.height(); ++y)
       for (int x = tile.x0(); x < tile.x0() + tile.width(); ++x) {
@@ -93,10 +93,10 @@ double estimated_error(const std::vector<FilmTile>& film, const std::vector<bool
         const auto m = tile.mean_xyz(x, y);
         const auto v = tile.luminance_variance_of_mean(x, y);
         if (!m || !v) continue;
-        var_sum += *v;
-        y2 += m->y * m->y;
+        sums.sum_var += *v;
+        sums.sum_Y2 += m->y * m->y;
       }
-  return y2 > 0.0 ? std::sqrt(var_sum / y2) : 0.0;
+  return sums.relative_rms().value_or(0.0);
 }
 
 // The reference: many passes with another seed, cached as raw doubles.

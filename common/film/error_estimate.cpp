@@ -4,16 +4,26 @@
 #include <cmath>
 
 namespace skyfarm {
+namespace {
+
+// sqrt(sum var / sum Y^2) with the true sum Y^2 estimated from the film's:
+// sum Y^2 - sum var, at least kMinSignalShare of it (the header says why).
+double relative_rms_of(double sum_var, double sum_film2) {
+  const double sum_true2 = std::max(sum_film2 - sum_var, ErrorSums::kMinSignalShare * sum_film2);
+  return std::sqrt(sum_var / sum_true2);
+}
+
+}  // namespace
 
 std::optional<double> ErrorSums::relative_rms() const {
   if (!(sum_Y2 > 0.0)) return std::nullopt;
-  return std::sqrt(sum_var / sum_Y2);
+  return relative_rms_of(sum_var, sum_Y2);
 }
 
 std::optional<Rgb> ErrorSums::relative_rms_rgb() const {
   if (!(sum_rgb2.r > 0.0) || !(sum_rgb2.g > 0.0) || !(sum_rgb2.b > 0.0)) return std::nullopt;
-  return Rgb{std::sqrt(sum_var_rgb.r / sum_rgb2.r), std::sqrt(sum_var_rgb.g / sum_rgb2.g),
-             std::sqrt(sum_var_rgb.b / sum_rgb2.b)};
+  return Rgb{relative_rms_of(sum_var_rgb.r, sum_rgb2.r), relative_rms_of(sum_var_rgb.g, sum_rgb2.g),
+             relative_rms_of(sum_var_rgb.b, sum_rgb2.b)};
 }
 
 ErrorSums error_sums(const FilmTile& tile, const std::vector<std::uint32_t>& excluded, int image_width) {

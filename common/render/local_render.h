@@ -3,7 +3,7 @@
 // resolved into the output image.  The result does not depend on the thread
 // count.  Also reports the image-level estimated relative RMS error of
 // luminance, sqrt(sum_i var(Y_i) / sum_i Y_i^2) over the pixels with an
-// estimate (DESIGN §6).
+// estimate (ErrorSums::relative_rms; DESIGN §6).
 #pragma once
 #include <functional>
 #include <optional>
