@@ -70,7 +70,7 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
   return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
           {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
-          {"method", plan.lut ? "lut" : "path"}};
+          {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control}};
 }
 
 // A job's image at one moment, ready to be encoded and stored: dir/stem.exr|png.

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -188,6 +189,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
   int passes = 32, seed = 1;
   std::string only;
   IntegratorOptions options;
+  std::optional<bool> roulette_control;  // the plan's choice unless given
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--out" && i + 1 < args.size()) dir = args[++i];
     else if (args[i] == "--scene" && i + 1 < args.size()) only = args[++i];
@@ -205,10 +207,15 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       options.max_camera_majorant_scale = std::atof(args[++i].c_str());
     else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size())
       options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
+    else if (args[i] == "--roulette-control")
+      roulette_control = true;
+    else if (args[i] == "--no-roulette-control")
+      roulette_control = false;
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
-                   "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n";
+                   "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n"
+                   "  [--roulette-control | --no-roulette-control]\n";
       return 2;
     }
   }
@@ -217,7 +224,8 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     if (!only.empty() && only != s.name) continue;
     const std::vector<double> ref = reference(s, passes * 16, dir);
     const auto request = api::parse_render_request(request_json(s, passes * 16, seed));
-    const api::RenderSetup setup = api::make_render_setup(request);
+    api::RenderSetup setup = api::make_render_setup(request);
+    if (roulette_control) setup.plan.roulette_control = *roulette_control;
     const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan, options);
     const std::vector<bool> keep = sky_mask(setup);
     std::vector<double> times, truths, estimates;
@@ -247,6 +255,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
                                 {"seconds", times.back()},
                                 {"samples_per_pixel", passes * 16},
                                 {"forced_collision_segments", options.forced_collision_segments},
+                                {"roulette_control", setup.plan.roulette_control},
                                 {"fitted_slope", fitted_slope(times, truths)},
                                 {"worst_estimate_ratio", worst},
                                 {"efficiency_1_over_err2_time", efficiency}}

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/core/constants.h"
+#include "common/render/radiance_control.h"
 #include "common/render/scene.h"
 #include "common/render/volume_path_integrator.h"
 
@@ -30,11 +31,12 @@ glm::dvec3 direction(double zenith_deg, double azimuth_deg) {
   return {std::sin(z) * std::sin(a), std::sin(z) * std::cos(a), std::cos(z)};
 }
 
-EfficiencyResult measure(double sun_zenith_deg, int samples, const IntegratorOptions& options) {
+EfficiencyResult measure(double sun_zenith_deg, int samples, IntegratorOptions options, bool roulette_control) {
   SunSpec sun;
   sun.zenith_deg = sun_zenith_deg;
   sun.azimuth_deg = 180.0;
   const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun, Location{}, std::nullopt, 360.0, 830.0);
+  if (roulette_control) options.roulette_control = std::make_shared<const RadianceControl>(scene);
   const VolumePathIntegrator integrator(scene, options);
   SampledWavelengths wl;
   wl.lambda_nm.fill(550.0);
@@ -79,7 +81,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
   int samples = 1000;
   std::vector<double> suns;
   IntegratorOptions options;
-  bool breakdown = false;
+  bool breakdown = false, roulette_control = false;
   for (std::size_t i = 1; i < args.size(); ++i) {  // args[0] is "efficiency"
     if (args[i] == "--samples" && i + 1 < args.size()) {
       samples = std::max(2, std::atoi(args[++i].c_str()));
@@ -101,6 +103,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
     } else if (args[i] == "--breakdown") {
       breakdown = true;
+    } else if (args[i] == "--roulette-control") {
+      roulette_control = true;
     } else if (args[i] == "--sunlit-segments") {
       options.explicit_single_scattering = true;
     } else if (args[i] == "--residual-below-cos" && i + 1 < args.size()) {
@@ -115,13 +119,14 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       std::cerr << "usage: skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] "
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
                    "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
-                   "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n";
+                   "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n"
+                   "  [--roulette-control]\n";
       return 2;
     }
   }
   if (suns.empty()) suns = {30.0, 85.0, 96.0};
   for (const double sun : suns) {
-    const EfficiencyResult r = measure(sun, samples, options);
+    const EfficiencyResult r = measure(sun, samples, options, roulette_control);
     const double rel2 = r.relative_std_per_path * r.relative_std_per_path;
     std::cout << nlohmann::json{{"bench", "efficiency"},
                                 {"sun_zenith_deg", sun},
@@ -129,6 +134,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                                 {"shadow_majorant_scale", options.shadow_majorant_scale},
                                 {"sunlit_segments", options.explicit_single_scattering},
                                 {"residual_ratio_tracking", options.residual_ratio_tracking},
+                                {"roulette_control", roulette_control},
                                 {"relative_std_per_path", r.relative_std_per_path},
                                 {"microseconds_per_path", r.microseconds_per_path},
                                 {"efficiency", rel2 > 0.0 ? 1.0 / (rel2 * r.microseconds_per_path) : 0.0},

@@ -40,6 +40,12 @@ struct RenderPlan {
   // The LUT renderer (method "lut", common/lut/): one deterministic sample
   // per pixel and batch from the tables instead of paths; approximate.
   bool lut = false;
+  // Russian roulette with the LUT sky as a control variate
+  // (IntegratorOptions::roulette_control): path-traced renders with the sun
+  // at most kRouletteControlMaxSunZenith_deg from the observer's zenith,
+  // where it pays (docs/physics.md, "Roulette with a control variate").
+  bool roulette_control = false;
+  static constexpr double kRouletteControlMaxSunZenith_deg = 50.0;
   int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }

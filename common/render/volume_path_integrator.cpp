@@ -1,5 +1,7 @@
 #include "common/render/volume_path_integrator.h"
 
+#include "common/render/radiance_control.h"
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -268,7 +270,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
     }
     st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
     st.sun_from_segment_estimator = explicit_single;
-    if (!survives(&st, ray.o, depth, sampler, counters)) return L;
+    if (!survives(&st, ray.o, ray.d, depth, c, &L)) return L;
   }
 }
 
@@ -378,26 +380,49 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
   st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
-  return survives(st, p, depth, c.sampler, c.counters);
+  return survives(st, p, wi, depth, c, L);
 }
 
 // Russian roulette on the MIS-normalised throughput after the vertex at
-// `depth` (at p), against 1 or, in the planet's shadow, the lower
-// rr_threshold_in_shadow: a throughput beta below the threshold w survives
-// with probability beta / w and becomes w; and the depth cap.  False ends
-// the path.
-bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, int depth, Sampler& sampler,
-                                   PathCounters* counters) const {
+// `depth` (at p, the path going on along wi), against 1 or, in the planet's
+// shadow, the lower rr_threshold_in_shadow: a throughput beta below the
+// threshold w survives with probability s = beta / w and becomes w; and the
+// depth cap.  False ends the path.
+//
+// With the roulette control (outside the planet's shadow), c = beta L~(p, wi)
+// with L~ the control's radiance towards wi: a path that ends adds c, one
+// that goes on adds -c (1 - s) / s now and its rest X / s later, so the
+// estimate of the rest is c + (X - c) / s, of mean E[X] for any c.  Paths
+// are never negative: s is raised to at least c_i / (L_i + c_i) at each
+// wavelength, L the light this path has gathered (at s = 1 nothing changes).
+bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth,
+                                    const PathContext& c, SampledSpectrum* L) const {
   if (st->beta.is_zero()) return false;
   const SampledSpectrum rr_beta = st->beta * (1.0 / st->r_u.average());
-  const double w = in_planet_shadow(p) ? options_.rr_threshold_in_shadow : 1.0;
+  const bool in_shadow = in_planet_shadow(p);
+  const double w = in_shadow ? options_.rr_threshold_in_shadow : 1.0;
   if (depth + 1 >= options_.rr_start_depth && w > 0.0 && rr_beta.max() < w) {
-    const double q = std::max(0.0, 1.0 - rr_beta.max() / w);
-    if (sampler.next() < q) return false;
-    st->beta *= 1.0 / (1.0 - q);
+    if (options_.roulette_control && !in_shadow) {
+      const SampledSpectrum c_rest = options_.roulette_control->radiance(p, wi, c.lambda) * rr_beta;
+      double s = rr_beta.max() / w;
+      for (int i = 0; i < kWavelengthsPerPath; ++i)
+        if (c_rest[i] > 0.0) s = std::max(s, c_rest[i] / ((*L)[i] + c_rest[i]));
+      if (s < 1.0) {
+        if (c.sampler.next() >= s) {
+          *L += c_rest;
+          return false;
+        }
+        *L = clamp_zero(*L - c_rest * ((1.0 - s) / s));  // >= 0 but for round-off
+        st->beta *= 1.0 / s;
+      }
+    } else {
+      const double q = std::max(0.0, 1.0 - rr_beta.max() / w);
+      if (c.sampler.next() < q) return false;
+      st->beta *= 1.0 / (1.0 - q);
+    }
   }
   if (depth + 1 >= options_.max_depth) {
-    ++counters->depth_limit;
+    ++c.counters->depth_limit;
     return false;
   }
   return true;

@@ -1,0 +1,33 @@
+// The scene plan a request compiles to (api/render_setup.h render_plan_for):
+// which renders get Russian roulette with the LUT sky as a control variate.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "api/render_request.h"
+#include "api/render_setup.h"
+
+namespace skyfarm::api {
+namespace {
+
+// A small equirect view under the sun at `zenith_deg`, rendered by `method`.
+RenderPlan plan_of(double zenith_deg, const char* method = "path") {
+  const std::string json = std::string(R"({"sun": {"zenith_deg": )") + std::to_string(zenith_deg) +
+                           R"(, "azimuth_deg": 180}, "camera": {"projection": "equirectangular", "width": 64, "height": 32},
+                              "method": ")" + method + "\"}";
+  return make_render_setup(parse_render_request(json)).plan;
+}
+
+TEST(RenderPlanFor, RouletteControlOnlyForPathTracedSkiesWithAHighSun) {
+  EXPECT_TRUE(plan_of(30.0).roulette_control);
+  EXPECT_TRUE(plan_of(50.0).roulette_control);
+  // Lower suns: the LUT's multiple scattering is too far off to pay
+  // (docs/physics.md, "Roulette with a control variate").
+  EXPECT_FALSE(plan_of(60.0).roulette_control);
+  EXPECT_FALSE(plan_of(96.0).roulette_control);
+  // The LUT renderer traces no paths.
+  EXPECT_FALSE(plan_of(30.0, "lut").roulette_control);
+}
+
+}  // namespace
+}  // namespace skyfarm::api
