@@ -207,6 +207,8 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       options.max_camera_majorant_scale = std::atof(args[++i].c_str());
     else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size())
       options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
+    else if (args[i] == "--rr-start-depth" && i + 1 < args.size())
+      options.rr_start_depth = std::atoi(args[++i].c_str());
     else if (args[i] == "--roulette-control")
       roulette_control = true;
     else if (args[i] == "--no-roulette-control")
@@ -215,7 +217,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
                    "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n"
-                   "  [--roulette-control | --no-roulette-control]\n";
+                   "  [--roulette-control | --no-roulette-control] [--rr-start-depth D]\n";
       return 2;
     }
   }

@@ -31,6 +31,15 @@ class PathMajorants {
     for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) m.v[i] = columns_[i][shell];
     return m;
   }
+  // The hero's (wavelength 0's) alone.
+  double sigma_maj0(std::size_t shell) const { return columns_[0][shell]; }
+  // tau += sigma_maj(shell) * length, read straight from the columns: the
+  // same values and operations as through sigma_maj, without a spectrum
+  // stored as 4 doubles and read back as 2 pairs (a store-forwarding stall
+  // per pair on every shell crossed).
+  void add_optical_depth(std::size_t shell, double length, SampledSpectrum* tau) const {
+    for (std::size_t i = 0; i < kWavelengthsPerPath; ++i) tau->v[i] += columns_[i][shell] * length;
+  }
 
  private:
   const ShellMajorants& shells_;

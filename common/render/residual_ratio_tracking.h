@@ -58,18 +58,19 @@ inline TrackedTransmittance residual_ratio_tracking(const AtmosphereMedium& medi
   ShellTraversal walk(ray, radial, R, residual.bottoms, t_begin, t_end);
   ShellSegment segment;
   while (walk.next(&segment)) {
-    const SampledSpectrum mu_r = residual_of.sigma_maj(segment.shell);
-    const SampledSpectrum sigma_c = control_of.sigma_maj(segment.shell);
+    const double mu_r0 = residual_of.sigma_maj0(segment.shell);
     double t = segment.t0;
     while (true) {
-      const double tau_rest = mu_r[0] * (segment.t1 - t);
+      const double tau_rest = mu_r0 * (segment.t1 - t);
       if (tau_target >= tau_rest) {  // no collision in the rest of this segment
         tau_target -= tau_rest;
-        tau_r += mu_r * (segment.t1 - t);
-        tau_c += sigma_c * (segment.t1 - t);
+        residual_of.add_optical_depth(segment.shell, segment.t1 - t, &tau_r);
+        control_of.add_optical_depth(segment.shell, segment.t1 - t, &tau_c);
         break;
       }
-      const double dt = tau_target / mu_r[0];
+      const SampledSpectrum mu_r = residual_of.sigma_maj(segment.shell);
+      const SampledSpectrum sigma_c = control_of.sigma_maj(segment.shell);
+      const double dt = tau_target / mu_r0;
       t += dt;
       tau_r += mu_r * dt;
       tau_c += sigma_c * dt;
