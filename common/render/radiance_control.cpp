@@ -45,8 +45,7 @@ RadianceControl::RadianceControl(const Scene& scene, const RadianceControlResolu
   bins_ = std::clamp(static_cast<int>(range_nm / 20.0), 1, res_.bins);
   bin_width_ = range_nm / bins_;
 
-  LutResolution lut;
-  lut.spectral_bins = bins_;
+  const LutResolution lut = lut_resolution(bins_);
   const LutSky sky = LutSky::build(atmosphere, scene.sun(), scene.observer_altitude_m(), scene.lambda_min_nm(),
                                    scene.lambda_max_nm(), lut);
   values_.assign(index(res_.altitudes, 0, 0, 0), 0.0f);
@@ -64,6 +63,28 @@ RadianceControl::RadianceControl(const Scene& scene, const RadianceControlResolu
             out[b] = std::isfinite(v) && v > 0.0 ? static_cast<float>(v) : 0.0f;
           }
         }
+}
+
+LutResolution RadianceControl::lut_resolution(int bins) {
+  LutResolution r;
+  r.spectral_bins = bins;
+  r.transmittance_mu = 64;
+  r.transmittance_r = 32;
+  r.transmittance_steps = 32;
+  r.multiple_scattering_mu_s = 16;
+  r.multiple_scattering_altitude = 16;
+  r.multiple_scattering_directions = 32;
+  r.multiple_scattering_steps = 10;
+  r.ground_irradiance_mu_s = 16;
+  r.ground_irradiance_directions = 32;
+  r.ground_irradiance_steps = 10;
+  r.sky_view_azimuth = 16;  // the sky-view and aerial tables are not read
+  r.sky_view_zenith = 16;
+  r.sky_view_steps = 4;
+  r.aerial_azimuth = 4;
+  r.aerial_zenith = 4;
+  r.aerial_slices = 4;
+  return r;
 }
 
 double RadianceControl::altitude_of(int a) const {

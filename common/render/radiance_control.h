@@ -17,7 +17,7 @@
 // of the path's own noise stays.  The table is coarse on purpose: from
 // 16 x 32 x 17 x 16 nodes (0.3 s to build) down to 8 x 16 x 5 x 8 the noon
 // image's error at equal samples did not move (1.75 %; 4 x 8 x 3 x 4: 1.77 %),
-// so the default costs about 0.05 s per job, most of it the LUT itself.
+// and the LUT it marches through is coarse too (lut_resolution).
 //
 // Table (float, interpolated multilinearly in all four coordinates and
 // linearly between bin centres in wavelength):
@@ -41,6 +41,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "common/lut/lut_sky.h"
 #include "common/render/scene.h"
 #include "common/spectrum/sampled_spectrum.h"
 #include "common/spectrum/wavelength_sampling.h"
@@ -62,6 +63,9 @@ class RadianceControl {
   SampledSpectrum radiance(const glm::dvec3& p, const glm::dvec3& wi, const SampledWavelengths& lambda) const;
 
   int bins() const { return bins_; }
+  // The LUT sky the nodes are marched through: coarse tables (a control
+  // needs no more; see above), `bins` spectral bins.
+  static LutResolution lut_resolution(int bins);
   // The tabulated value at node (altitude a, view row m, sun angle s,
   // azimuth k), bin b (tests).
   float node(int a, int m, int s, int k, int b) const { return values_[index(a, m, s, k) + static_cast<std::size_t>(b)]; }

@@ -30,8 +30,7 @@ TEST(RadianceControl, NodesAreTheLutSkysMarches) {
   const RadianceControlResolution res;
   const RadianceControl control(scene, res);
   ASSERT_EQ(control.bins(), 8);  // 300 nm at most one bin per 20 nm, capped at 8
-  LutResolution lut;
-  lut.spectral_bins = control.bins();
+  const LutResolution lut = RadianceControl::lut_resolution(control.bins());
   const LutSky sky = LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(), 400.0, 700.0, lut);
   std::vector<double> L(8);
   int checked = 0;
