@@ -44,6 +44,18 @@ class BrokerTest : public ::testing::Test {
   void TearDown() override {
     if (broker_) broker_->stop();
   }
+  // True when no UNIT reaches `p` for `d`.  The peer heart-beats every 50 ms
+  // meanwhile: a silent peer is expired after 3 x 100 ms, so a plain 300 ms
+  // wait raced the expiry, and lost it on a loaded machine (the unit owed
+  // after the next result then never came).
+  static bool no_unit_for(RawPeer& p, std::chrono::milliseconds d, api::HeartbeatMsg heartbeat = {}) {
+    const auto until = std::chrono::steady_clock::now() + d;
+    while (std::chrono::steady_clock::now() < until) {
+      p.send(heartbeat);
+      if (p.receive_a<api::UnitMsg>(50ms)) return false;
+    }
+    return true;
+  }
 
   zmq::context_t ctx_;
   FakeBackend backend_;
@@ -130,7 +142,7 @@ TEST_F(BrokerTest, CreditLimitsUnitsToTheWorkersSlots) {
   ASSERT_TRUE(u);
   EXPECT_EQ(u->unit.tile, 0);
   EXPECT_EQ(u->request, "{}");
-  EXPECT_FALSE(p->receive_a<api::UnitMsg>(300ms)) << "a second unit beyond the worker's 1 slot";
+  EXPECT_TRUE(no_unit_for(*p, 300ms)) << "a second unit beyond the worker's 1 slot";
   p->send(api::ResultMsg{u->unit, 10, 0.01, "tile"});
   auto u2 = p->receive_a<api::UnitMsg>();
   ASSERT_TRUE(u2);
@@ -157,7 +169,7 @@ TEST_F(BrokerTest, SlotsAreFilledAndFailuresFreeThem) {
     ASSERT_TRUE(u);
     units.push_back(*u);
   }
-  EXPECT_FALSE(p->receive_a<api::UnitMsg>(200ms));
+  EXPECT_TRUE(no_unit_for(*p, 200ms));
   p->send(api::FailedMsg{units[1].unit, "out of memory"});
   ASSERT_TRUE(p->receive_a<api::UnitMsg>());
   ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.failed.size() == 1; }));
@@ -244,7 +256,7 @@ TEST_F(BrokerTest, DrainingWorkerGetsNoMoreUnits) {
   ASSERT_TRUE(u);
   p->send(api::HeartbeatMsg{100, true});
   p->send(api::ResultMsg{u->unit, 1, 0.1, "tile"});
-  EXPECT_FALSE(p->receive_a<api::UnitMsg>(300ms));
+  EXPECT_TRUE(no_unit_for(*p, 300ms, api::HeartbeatMsg{100, true}));
   p->send(api::DisconnectMsg{"worker draining", false});
   ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.left.size() == 1; }));
   backend_.with_lock([](auto& b) {
