@@ -24,6 +24,8 @@ namespace {
 // Rays leaving the ground start this far above it, so a ray going up can
 // never meet the sphere it starts on (a convex surface), whatever the round-off.
 constexpr double kGroundOffset_m = 1e-6;
+// The roulette control raises survival to at most this many times roulette's.
+constexpr double kMaxRaise = 2.0;
 
 }  // namespace
 
@@ -394,7 +396,11 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // that goes on adds -c (1 - s) / s now and its rest X / s later, so the
 // estimate of the rest is c + (X - c) / s, of mean E[X] for any c.  Paths
 // are never negative: s is raised to at least c_i / (L_i + c_i) at each
-// wavelength, L the light this path has gathered (at s = 1 nothing changes).
+// wavelength, L the light this path has gathered (at s = 1 nothing changes),
+// but to at most kMaxRaise times the plain survival; beyond that c is
+// clipped to L s / (1 - s) (still a fixed c: unbiased).  Without the cap,
+// where the gathered light is small next to c (a dense haze, AOD 10, whose
+// direct sun is gone) paths ran 4x as long for 3x less efficiency.
 bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth,
                                     const PathContext& c, SampledSpectrum* L) const {
   if (st->beta.is_zero()) return false;
@@ -403,10 +409,15 @@ bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const gl
   const double w = in_shadow ? options_.rr_threshold_in_shadow : 1.0;
   if (depth + 1 >= options_.rr_start_depth && w > 0.0 && rr_beta.max() < w) {
     if (options_.roulette_control && !in_shadow) {
-      const SampledSpectrum c_rest = options_.roulette_control->radiance(p, wi, c.lambda) * rr_beta;
-      double s = rr_beta.max() / w;
+      SampledSpectrum c_rest = options_.roulette_control->radiance(p, wi, c.lambda) * rr_beta;
+      const double s_plain = rr_beta.max() / w;
+      double s = s_plain;
       for (int i = 0; i < kWavelengthsPerPath; ++i)
         if (c_rest[i] > 0.0) s = std::max(s, c_rest[i] / ((*L)[i] + c_rest[i]));
+      if (s > kMaxRaise * s_plain) {  // c beyond what the light gathered so far allows: clip it
+        s = kMaxRaise * s_plain;
+        for (int i = 0; i < kWavelengthsPerPath; ++i) c_rest[i] = std::min(c_rest[i], (*L)[i] * s / (1.0 - s));
+      }
       if (s < 1.0) {
         if (c.sampler.next() >= s) {
           *L += c_rest;

@@ -130,11 +130,11 @@ struct IntegratorOptions {
   // towards the next direction times the throughput); one that goes on adds
   // (X - c) / s.  Unbiased whatever c is; survival is raised where needed so
   // that no path's sum turns negative.  Null: plain roulette.  Built per job
-  // when the sun is high (RenderPlan::roulette_control, where it pays).
+  // when the sun is up (RenderPlan::roulette_control, where it pays).
   // Measured (bench convergence, 64x32, 512 spp, true error and user CPU s):
   // noon 1.59 % (1.79) -> 1.30 % (1.97), 400 km 1.76 % (2.06) -> 1.34 %
   // (2.56), haze 2.85 % (3.10) -> 2.39 % (3.3-3.6): 1.25-1.39x the
-  // efficiency; at lower suns the LUT is too far off to pay (more in
+  // efficiency; 1.1-1.2x with the sun at 60-85 deg, 0.96x at 90 (more in
   // docs/physics.md, "Roulette with a control variate").
   std::shared_ptr<const RadianceControl> roulette_control;
 };

@@ -20,10 +20,10 @@ RenderPlan plan_of(double zenith_deg, const char* method = "path") {
 
 TEST(RenderPlanFor, RouletteControlOnlyForPathTracedSkiesWithAHighSun) {
   EXPECT_TRUE(plan_of(30.0).roulette_control);
-  EXPECT_TRUE(plan_of(50.0).roulette_control);
-  // Lower suns: the LUT's multiple scattering is too far off to pay
-  // (docs/physics.md, "Roulette with a control variate").
-  EXPECT_FALSE(plan_of(60.0).roulette_control);
+  EXPECT_TRUE(plan_of(85.0).roulette_control);
+  // A sun at the horizon or below: it no longer pays (docs/physics.md,
+  // "Roulette with a control variate").
+  EXPECT_FALSE(plan_of(90.0).roulette_control);
   EXPECT_FALSE(plan_of(96.0).roulette_control);
   // The LUT renderer traces no paths.
   EXPECT_FALSE(plan_of(30.0, "lut").roulette_control);

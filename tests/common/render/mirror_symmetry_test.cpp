@@ -39,7 +39,8 @@ TEST(MirrorSymmetry, HalfRenderedHalfMirroredAndPhysicallyRight) {
   Image mirrored(128, 64);
   const LocalRenderResult rm = render_image(half, &mirrored, 2);
 
-  const RenderPlan full_plan = make_render_plan(128, 64, 360.0, 830.0, 1, 32, 1);
+  RenderPlan full_plan = make_render_plan(128, 64, 360.0, 830.0, 1, 32, 1);
+  full_plan.roulette_control = setup.plan.roulette_control;  // the same estimator
   ASSERT_FALSE(full_plan.mirrored);
   const TileRenderer full(*setup.scene, *setup.camera, full_plan);
   Image reference(128, 64);
