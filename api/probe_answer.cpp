@@ -5,7 +5,9 @@
 #include "common/core/constants.h"
 #include "common/geometry/ray.h"
 #include "common/lut/lut_probe.h"
+#include "common/render/radiance_control.h"
 #include "common/render/radiance_probe.h"
+#include "common/render/render_plan.h"
 
 namespace skyfarm::api {
 namespace {
@@ -60,6 +62,11 @@ ProbePlan probe_plan(const ProbeRequest& request) {
                          static_cast<std::uint64_t>(request.samples), max_units);
 }
 
+std::shared_ptr<const RadianceControl> probe_roulette_control(const ProbeRequest& request, const Scene& scene) {
+  if (request.method != Method::kPath || !roulette_control_pays(scene.sun().zenith_deg())) return nullptr;
+  return std::make_shared<const RadianceControl>(scene);
+}
+
 nlohmann::json path_probe_answer(const ProbeRequest& request, const ProbeResult& result) {
   const Sun sun = Sun::from_spec(request.sun, request.location, request.time);
   return answer(request, sun, result.radiance, result.standard_error, result.counters.nonfinite);
@@ -73,7 +80,8 @@ nlohmann::json answer_probe(const ProbeRequest& request, int threads) {
                   probe_radiance_lut(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(), dirs,
                                      request.wavelengths_nm),
                   nullptr, 0);
-  const ProbeResult r = probe_radiance(scene, dirs, request.wavelengths_nm, probe_plan(request), request.seed, threads);
+  const ProbeResult r = probe_radiance(scene, dirs, request.wavelengths_nm, probe_plan(request), request.seed, threads,
+                                       probe_roulette_control(request, scene));
   return path_probe_answer(request, r);
 }
 

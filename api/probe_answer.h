@@ -6,8 +6,9 @@
 // Nothing in it depends on how or where the probe ran (no timings), so the
 // farm's answer and the CLI's are the same document, number for number.
 // "path" traces the probe's units (common/render/probe_units.h) on `threads`
-// threads (0: all cores); "lut" answers from one-bin tables per wavelength
-// (common/lut/lut_probe.h).
+// threads (0: all cores), with the roulette's control variate when the sun
+// is up to 85 deg from the zenith (probe_roulette_control, as for renders);
+// "lut" answers from one-bin tables per wavelength (common/lut/lut_probe.h).
 //
 // The probe's cut into units is probe_plan(): ProbePlan::make(directions x
 // wavelengths, samples, max_units) with max_units = 4096, fewer for a long
@@ -15,6 +16,7 @@
 // under 256 MiB, and never below 64 units).  The farm (server/probe_service.h,
 // the worker) and the CLI all use it, which is what makes their answers equal.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -31,6 +33,11 @@ Scene probe_scene(const ProbeRequest& request);
 // The directions as unit vectors in the observer frame (x east, y north, z up).
 std::vector<glm::dvec3> probe_directions(const ProbeRequest& request);
 ProbePlan probe_plan(const ProbeRequest& request);
+// The roulette's control variate for a "path" probe whose sun is up to
+// RenderPlan::kRouletteControlMaxSunZenith_deg from the zenith (as for
+// renders), built from its scene; null otherwise.  The CLI and the farm's
+// workers both trace with it, so their answers stay equal.
+std::shared_ptr<const RadianceControl> probe_roulette_control(const ProbeRequest& request, const Scene& scene);
 
 // The "path" answer from the reduced result.
 nlohmann::json path_probe_answer(const ProbeRequest& request, const ProbeResult& result);

@@ -21,7 +21,7 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
                                      lut ? 1 : kSamplesPerPass,
                                      mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
-  plan.roulette_control = !lut && sun.zenith_deg() <= RenderPlan::kRouletteControlMaxSunZenith_deg;
+  plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
   return plan;
 }
 

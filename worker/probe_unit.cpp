@@ -15,7 +15,8 @@ ProbeSetup make_probe_setup(const std::string& request_text) {
     Scene scene = api::probe_scene(request);
     std::vector<glm::dvec3> directions = api::probe_directions(request);
     const ProbePlan plan = api::probe_plan(request);
-    return ProbeSetup{std::move(request), std::move(scene), std::move(directions), plan};
+    std::shared_ptr<const RadianceControl> control = api::probe_roulette_control(request, scene);
+    return ProbeSetup{std::move(request), std::move(scene), std::move(directions), plan, std::move(control)};
   } catch (const api::ValidationError& e) {
     throw std::runtime_error(std::string("invalid probe request: ") + e.what());
   } catch (const std::exception& e) {
@@ -31,7 +32,8 @@ api::Message run_probe_unit(const ProbeSetup& setup, const api::UnitMsg& task) {
       throw std::runtime_error("probe unit " + std::to_string(u.tile) + " is outside the probe's " +
                                std::to_string(setup.plan.unit_count()) + " units");
     const ProbeUnitSums sums = trace_probe_unit(setup.scene, setup.directions, setup.request.wavelengths_nm,
-                                                setup.request.seed, setup.plan.unit(static_cast<std::size_t>(u.tile)));
+                                                setup.request.seed, setup.plan.unit(static_cast<std::size_t>(u.tile)),
+                                                setup.control);
     const std::vector<std::uint8_t> bytes = sums.serialize();
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return api::ResultMsg{u, sums.counters.paths, seconds, std::string(bytes.begin(), bytes.end())};

@@ -6,6 +6,7 @@
 // reason (a request that does not parse or is not a "path" probe, a unit
 // outside the plan, anything the tracer throws).
 #pragma once
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,7 @@ struct ProbeSetup {
   Scene scene;
   std::vector<glm::dvec3> directions;
   ProbePlan plan;
+  std::shared_ptr<const RadianceControl> control;  // api::probe_roulette_control
 };
 
 // Throws std::runtime_error naming what is wrong with the request.

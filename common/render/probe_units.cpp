@@ -131,8 +131,11 @@ ProbeUnitSums ProbeUnitSums::deserialize(const std::vector<std::uint8_t>& bytes,
 // --- Tracing ------------------------------------------------------------------------
 
 ProbeUnitSums trace_probe_unit(const Scene& scene, const std::vector<glm::dvec3>& directions,
-                               const std::vector<double>& wavelengths_nm, std::uint64_t seed, const ProbeUnit& unit) {
-  const VolumePathIntegrator integrator(scene);
+                               const std::vector<double>& wavelengths_nm, std::uint64_t seed, const ProbeUnit& unit,
+                               std::shared_ptr<const RadianceControl> control) {
+  IntegratorOptions options;
+  options.roulette_control = std::move(control);
+  const VolumePathIntegrator integrator(scene, options);
   const std::size_t W = wavelengths_nm.size();
   if (W == 0 || unit.pair_end > directions.size() * W)
     throw std::invalid_argument("probe unit: pairs outside the request's directions x wavelengths");

@@ -34,6 +34,7 @@
 #pragma once
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <vector>
 
@@ -91,9 +92,11 @@ struct ProbeUnitSums {
 };
 
 // Traces one unit on the calling thread.  directions: unit vectors in the
-// observer frame; wavelengths: as in the request (pair p = d * W + w).
+// observer frame; wavelengths: as in the request (pair p = d * W + w);
+// control: the roulette's control variate (IntegratorOptions), or none.
 ProbeUnitSums trace_probe_unit(const Scene& scene, const std::vector<glm::dvec3>& directions,
-                               const std::vector<double>& wavelengths_nm, std::uint64_t seed, const ProbeUnit& unit);
+                               const std::vector<double>& wavelengths_nm, std::uint64_t seed, const ProbeUnit& unit,
+                               std::shared_ptr<const RadianceControl> control = nullptr);
 
 // Collects the units' sums and combines them in canonical order.  Not thread-safe.
 class ProbeReduction {

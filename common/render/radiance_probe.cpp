@@ -18,7 +18,7 @@ ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& di
 
 ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& directions,
                            const std::vector<double>& wavelengths_nm, const ProbePlan& plan, std::uint64_t seed,
-                           int threads) {
+                           int threads, std::shared_ptr<const RadianceControl> control) {
   if (plan.pairs != directions.size() * wavelengths_nm.size())
     throw std::invalid_argument("probe_radiance: the plan is not for these directions and wavelengths");
   // One task per pair of each unit: the cells a farm worker traces in a row,
@@ -29,7 +29,7 @@ ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& di
     ProbeUnit cell = plan.unit(chunk * plan.groups + pair / plan.pairs_per_unit);
     cell.pair_begin = pair;
     cell.pair_end = pair + 1;
-    cells[task] = trace_probe_unit(scene, directions, wavelengths_nm, seed, cell);
+    cells[task] = trace_probe_unit(scene, directions, wavelengths_nm, seed, cell, control);
   });
   // Regroup the cells into the plan's units and reduce them as the server does.
   ProbeReduction reduction(plan);

@@ -7,6 +7,7 @@
 // of threads and equals the farm's for the same plan.
 #pragma once
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -29,9 +30,10 @@ struct ProbePlan;
 ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& directions,
                            const std::vector<double>& wavelengths_nm, int samples, std::uint64_t seed,
                            int threads = 0);
-// The same cut by `plan` (plan.pairs must be directions x wavelengths).
+// The same cut by `plan` (plan.pairs must be directions x wavelengths),
+// with the roulette's control variate if one is given.
 ProbeResult probe_radiance(const Scene& scene, const std::vector<glm::dvec3>& directions,
                            const std::vector<double>& wavelengths_nm, const ProbePlan& plan, std::uint64_t seed,
-                           int threads = 0);
+                           int threads = 0, std::shared_ptr<const RadianceControl> control = nullptr);
 
 }  // namespace skyfarm

@@ -65,6 +65,12 @@ struct RenderPlan {
   std::vector<WorkUnit> units() const;
 };
 
+// Whether the roulette control pays for a sun this far from the observer's
+// zenith (RenderPlan::roulette_control; path probes follow the same rule).
+inline bool roulette_control_pays(double sun_zenith_deg) {
+  return sun_zenith_deg <= RenderPlan::kRouletteControlMaxSunZenith_deg;
+}
+
 RenderPlan make_render_plan(int width, int height, double lambda_min_nm, double lambda_max_nm, int batches,
                             int samples_per_pixel, std::uint64_t seed, int tile_size = 32, int samples_per_pass = 16,
                             bool mirrored = false);

@@ -370,9 +370,11 @@ TEST_F(FarmWorkerTest, ProbeUnitsAreTracedAsTheLocalProbeDoes) {
   start_worker();
   ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() + f.failed.size() == 3; }, 10s));
   const ProbePlan plan = api::probe_plan(probe);
+  const Scene scene = api::probe_scene(probe);
+  ASSERT_TRUE(api::probe_roulette_control(probe, scene)) << "sun 40 deg from the zenith";
   const std::vector<std::uint8_t> expected =
-      trace_probe_unit(api::probe_scene(probe), api::probe_directions(probe), probe.wavelengths_nm, probe.seed,
-                       plan.unit(0))
+      trace_probe_unit(scene, api::probe_directions(probe), probe.wavelengths_nm, probe.seed, plan.unit(0),
+                       api::probe_roulette_control(probe, scene))
           .serialize();
   backend_.with_lock([&](auto& f) {
     EXPECT_EQ(f.joined.at(0).second["capabilities"]["probe"], api::kProbeUnitsVersion);
