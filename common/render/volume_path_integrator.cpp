@@ -388,8 +388,8 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // Russian roulette on the MIS-normalised throughput after the vertex at
 // `depth` (at p, the path going on along wi), against 1 or, in the planet's
 // shadow, the lower rr_threshold_in_shadow: a throughput beta below the
-// threshold w survives with probability s = beta / w and becomes w; and the
-// depth cap.  False ends the path.
+// threshold w survives with probability s = beta / w and becomes w; and,
+// before it, the depth cap.  False ends the path.
 //
 // With the roulette control (outside the planet's shadow), c = beta L~(p, wi)
 // with L~ the control's radiance towards wi: a path that ends adds c, one
@@ -404,6 +404,12 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth,
                                     const PathContext& c, SampledSpectrum* L) const {
   if (st->beta.is_zero()) return false;
+  // The depth cap first: a path cut there must not have paid the control's
+  // -c (1 - s) / s for a rest it never traces (bench efficiency --max-depth).
+  if (depth + 1 >= options_.max_depth) {
+    ++c.counters->depth_limit;
+    return false;
+  }
   const SampledSpectrum rr_beta = st->beta * (1.0 / st->r_u.average());
   const bool in_shadow = in_planet_shadow(p);
   const double w = in_shadow ? options_.rr_threshold_in_shadow : 1.0;
@@ -431,10 +437,6 @@ bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const gl
       if (c.sampler.next() < q) return false;
       st->beta *= 1.0 / (1.0 - q);
     }
-  }
-  if (depth + 1 >= options_.max_depth) {
-    ++c.counters->depth_limit;
-    return false;
   }
   return true;
 }
