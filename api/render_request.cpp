@@ -124,10 +124,11 @@ void read_quality(const Fields& top, QualitySpec& q) {
   const Json* v = top.find("quality");
   if (!v || !expect_object(*v, top.path_of("quality"), top.errors())) return;
   Fields f(*v, top.path_of("quality"), top.errors());
-  f.allow_only({"samples_per_pixel", "target_relative_error", "time_limit_s"});
+  f.allow_only({"samples_per_pixel", "target_relative_error", "time_limit_s", "adaptive"});
   f.integer("samples_per_pixel", 1, QualitySpec::kMaxSamplesPerPixel, q.samples_per_pixel);
   f.optional_number("target_relative_error", Range::open_closed(0, 1), q.target_relative_error);
   f.optional_number("time_limit_s", Range::open_closed(0, 604800), q.time_limit_s);
+  f.boolean("adaptive", q.adaptive);
   if (!v->contains("samples_per_pixel") && (q.target_relative_error || q.time_limit_s))
     q.samples_per_pixel = QualitySpec::kMaxSamplesPerPixel;
 }
@@ -183,6 +184,16 @@ Json camera_json(const CameraSpec& c) {
           {"fov_deg", canonical_number(fov)}};
 }
 
+// "adaptive" is written only when true, so that the requests of before it
+// keep their canonical text (their hash, their cached results).
+Json quality_json(const QualitySpec& q) {
+  Json j = {{"samples_per_pixel", q.samples_per_pixel},
+            {"target_relative_error", optional_number_json(q.target_relative_error)},
+            {"time_limit_s", optional_number_json(q.time_limit_s)}};
+  if (q.adaptive) j["adaptive"] = true;
+  return j;
+}
+
 }  // namespace
 
 RenderRequest parse_render_request(std::string_view json_text) {
@@ -210,10 +221,7 @@ nlohmann::json to_canonical_json(const RenderRequest& r) {
            {{"min_nm", canonical_number(r.spectral.min_nm)},
             {"max_nm", canonical_number(r.spectral.max_nm)},
             {"batches", r.spectral.batches}}},
-          {"quality",
-           {{"samples_per_pixel", r.quality.samples_per_pixel},
-            {"target_relative_error", optional_number_json(r.quality.target_relative_error)},
-            {"time_limit_s", optional_number_json(r.quality.time_limit_s)}}},
+          {"quality", quality_json(r.quality)},
           {"method", std::string(name_of(kMethods, r.method))},
           {"output",
            {{"exposure_ev", optional_number_json(r.output.exposure_ev)},

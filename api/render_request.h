@@ -42,6 +42,9 @@ struct QualitySpec {
   int samples_per_pixel = kDefaultSamplesPerPixel;
   std::optional<double> target_relative_error;  // image relative RMS error
   std::optional<double> time_limit_s;
+  // Variance-aware sample allocation after a uniform pilot pass
+  // (common/render/sample_allocation.h); path-traced renders only.
+  bool adaptive = false;
 };
 
 // "output": what the result files carry.

@@ -22,6 +22,7 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
                                      mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
+  plan.adaptive = !lut && request.quality.adaptive && plan.passes >= 2;
   return plan;
 }
 
@@ -30,7 +31,7 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
 namespace skyfarm::api {
 
 void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
-                         int samples_per_pixel, const ErrorSums& error) {
+                         double samples_per_pixel, const ErrorSums& error) {
   namespace key = metadata_key;
   image->set_metadata(key::kRequest, canonical_text(request));
   image->set_metadata(key::kSunZenithDeg, sun.zenith_deg());

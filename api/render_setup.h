@@ -30,6 +30,6 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun);
 // canonical request, sun position, samples, wavelength range, version,
 // method and the estimated error.
 void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
-                         int samples_per_pixel, const ErrorSums& error);
+                         double samples_per_pixel, const ErrorSums& error);
 
 }  // namespace skyfarm::api

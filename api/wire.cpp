@@ -155,6 +155,11 @@ Json header_of(const UnitMsg& m) {
   Json h = write_unit_ref(m.unit);
   h["request"] = m.request;
   if (m.kind == UnitKind::kProbe) h["kind"] = "probe";  // absent: render (the version 1 UNIT)
+  if (!m.samples_per_pass.empty()) {
+    Json n = Json::array();
+    for (const auto& [even, odd] : m.samples_per_pass) n.push_back(Json::array({even, odd}));
+    h["samples_per_pass"] = std::move(n);
+  }
   return h;
 }
 Json header_of(const ResultMsg& m) {
@@ -208,6 +213,22 @@ UnitMsg read_unit(const Json& h) {
   const std::string kind = get_string(h, "kind", 16, false);
   if (kind == "probe") m.kind = UnitKind::kProbe;
   else if (!kind.empty() && kind != "render") fail("\"kind\" must be render or probe");
+  if (const Json* n = field(h, "samples_per_pass", false)) {
+    if (!n->is_array() || n->empty() || n->size() > kMaxAllocationBlocks)
+      fail("\"samples_per_pass\" must be a non-empty array of at most " + std::to_string(kMaxAllocationBlocks) +
+           " [even, odd] pairs");
+    for (const Json& pair : *n) {
+      int v[2] = {0, 0};
+      for (std::size_t i = 0; i < 2; ++i) {
+        if (!pair.is_array() || pair.size() != 2 || !pair[i].is_number_integer() || pair[i].get<long long>() < 1 ||
+            pair[i].get<long long>() > kMaxSamplesPerPass)
+          fail("\"samples_per_pass\" must hold [even, odd] pairs of integers in [1, " +
+               std::to_string(kMaxSamplesPerPass) + "]");
+        v[i] = static_cast<int>(pair[i].get<long long>());
+      }
+      m.samples_per_pass.emplace_back(v[0], v[1]);
+    }
+  }
   return m;
 }
 ResultMsg read_result(const Json& h, const std::string& payload) {

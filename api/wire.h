@@ -17,7 +17,8 @@
 //   HEARTBEAT   both ways        heartbeat_ms? (sender's interval),            -
 //                                draining? (worker: send no more units)
 //   UNIT        server -> worker job, tile, batch, pass, attempt, request,     -
-//                                kind? (request: api::canonical_text of the job)
+//                                kind?, samples_per_pass? (request:
+//                                api::canonical_text of the job)
 //   RESULT      worker -> server job, tile, batch, pass, attempt, paths,        FilmTile bytes
 //                                seconds
 //   FAILED      worker -> server job, tile, batch, pass, attempt, message       -
@@ -32,7 +33,13 @@
 // ProbeUnitSums bytes (common/render/probe_units.h); the server sends them
 // only to workers whose READY capabilities hold "probe": kProbeUnitsVersion.
 //
-// Versioning: READY carries kProtocolVersion; the server refuses another
+// samples_per_pass: [[even, odd], ...], an adaptive render's samples per
+// pixel in this pass for each allocation block of the tile (row-major) and
+// the pixels of each parity of x + y (RenderPlan::sample_range,
+// common/render/sample_allocation.h); absent: the plan's uniform count.
+//
+// Versioning: READY carries kProtocolVersion (2 since samples_per_pass: a
+// version 1 worker would ignore it and render the wrong samples); the server refuses another
 // version with a fatal DISCONNECT.  Decoding is strict: an unknown command, a
 // header that is not a JSON object, a missing or mistyped field, a value out
 // of range or a wrong frame count throws WireError (the receivers count such
@@ -52,7 +59,7 @@
 
 namespace skyfarm::api {
 
-inline constexpr int kProtocolVersion = 1;
+inline constexpr int kProtocolVersion = 2;
 // The READY capability "probe" of a worker that runs probe units.
 inline constexpr int kProbeUnitsVersion = 1;
 
@@ -62,6 +69,8 @@ inline constexpr std::size_t kMaxHeaderBytes = 16u << 20;
 inline constexpr std::size_t kMaxIdBytes = 256;
 inline constexpr std::size_t kMaxMessageBytes = 64u << 10;  // FAILED text (longer ones are cut on encode)
 inline constexpr int kMaxSlots = 1024;
+inline constexpr int kMaxSamplesPerPass = 1 << 20;
+inline constexpr std::size_t kMaxAllocationBlocks = 1 << 16;
 
 // One ZeroMQ message: its frames as byte strings (identity frame excluded).
 using Frames = std::vector<std::string>;
@@ -109,6 +118,8 @@ struct UnitMsg {
   UnitRef unit;
   std::string request;  // canonical request text
   UnitKind kind = UnitKind::kRender;
+  // samples_per_pass: per allocation block of the tile, (even, odd); empty: absent (uniform).
+  std::vector<std::pair<int, int>> samples_per_pass;
   bool operator==(const UnitMsg&) const = default;
 };
 

@@ -387,7 +387,7 @@ void Broker::Loop::dispatch() {
       if (!unit) continue;
       w.in_flight[unit->attempt] = unit->key;
       api::UnitMsg msg{{unit->key.job_id, unit->key.tile, unit->key.batch, unit->key.pass, unit->attempt},
-                       std::move(unit->request_canonical), unit->kind};
+                       std::move(unit->request_canonical), unit->kind, std::move(unit->samples_per_pass)};
       if (!send(identity, msg)) {
         remove_worker(identity, "unreachable", true);  // the backend requeues the unit
         continue;

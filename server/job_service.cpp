@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <condition_variable>
+#include <cmath>
 #include <deque>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <random>
@@ -15,6 +17,7 @@
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
 #include "common/render/render_plan.h"
+#include "common/render/sample_allocation.h"
 #include "common/render/sun_pixels.h"
 #include "common/sampling/sampler.h"
 #include "server/job_store.h"
@@ -70,7 +73,8 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
   return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
           {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
-          {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control}};
+          {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control},
+          {"adaptive", plan.adaptive}};
 }
 
 // A job's image at one moment, ready to be encoded and stored: dir/stem.exr|png.
@@ -124,6 +128,21 @@ struct Job {
   fs::path dir;
   std::vector<std::uint32_t> sun_pixels;  // left out of the error estimate
   std::string group;                      // shares out passes with its group (set_group)
+  // Adaptive plans: the samples per pass of every tile after the pilot
+  // (sample_allocation.h), set once pass 0 is merged everywhere and kept in
+  // dir/allocation.json; until then no unit of a later pass is handed out.
+  std::optional<SampleAllocation> allocation;
+  bool waits_for_allocation() const { return plan.adaptive && !allocation; }
+  // Mean samples per pixel after `passes` whole passes (the EXR's metadata,
+  // as a local render writes it), and as the status shows it.
+  double mean_samples_per_pixel(int passes) const {
+    if (allocation) return allocation->mean_samples_per_pixel(plan, passes);
+    return std::min(plan.samples_per_pixel, passes * plan.samples_per_pass);
+  }
+  nlohmann::json samples_per_pixel(int passes) const {
+    if (allocation) return std::round(mean_samples_per_pixel(passes) * 10.0) / 10.0;
+    return std::min(plan.samples_per_pixel, passes * plan.samples_per_pass);
+  }
 
   std::size_t unit_index(const WorkUnit& u) const {
     return (static_cast<std::size_t>(u.pass) * static_cast<std::size_t>(plan.tile_count()) +
@@ -136,7 +155,10 @@ struct Job {
   bool finishing = false;
   bool active() const { return !finishing && !is_terminal(record.state); }
   bool has_work() const {
-    return active() && (!requeued.empty() || cursor < static_cast<std::size_t>(plan.unit_count()));
+    if (!active()) return false;
+    if (!requeued.empty()) return true;
+    return cursor < static_cast<std::size_t>(plan.unit_count()) &&
+           !(waits_for_allocation() && unit_at(plan, cursor).pass > 0);
   }
   double elapsed_s() const {
     if (!started) return 0.0;
@@ -197,6 +219,9 @@ struct JobService::Impl {
   ImageSnapshot snapshot_images(Job& job, bool final);
   void requeue(std::uint64_t attempt, bool tell_worker);
   void fail_job(Job& job, const std::string& message);
+  // An adaptive job's allocation from its merged pilot, stored before use;
+  // false when the job failed instead.
+  bool allocate(Job& job);
   void drop_attempts_of(Job& job);
   Job& lowest_pass_in_group(Job& chosen);
 };
@@ -326,7 +351,11 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
   const double fraction = job.record.state == "done" ? 1.0 : total > 0 ? static_cast<double>(merged) / total : 1.0;
   const double elapsed = job.elapsed_s();
   const int passes = job.merger->complete_passes();
-  const int spp = std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass);
+  const nlohmann::json spp = job.samples_per_pixel(passes);
+  nlohmann::json plan = job.plan_json;
+  if (job.allocation)
+    plan["samples_per_pass_after_pilot"] = {{"min", job.allocation->min_samples_per_pass()},
+                                            {"max", job.allocation->max_samples_per_pass()}};
   nlohmann::json eta = nullptr;
   if (job.active() && fraction > 0.0) eta = elapsed * (1.0 - fraction) / fraction;
   nlohmann::json workers_json = nlohmann::json::array();
@@ -356,7 +385,7 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
             {"sun_pixels_excluded", job.sun_pixels.size()},
             {"history", job.history}}},
           {"stopped_by", job.stopped_by.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.stopped_by)},
-          {"plan", job.plan_json},
+          {"plan", plan},
           {"workers", workers_json},
           {"failure", job.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.record.failure)},
           {"created_unix", job.record.created_unix},
@@ -426,8 +455,7 @@ ImageSnapshot JobService::Impl::snapshot_images(Job& job, bool final) {
   job.merger->resolve(&snap.image);
   const Sun sun = Sun::from_spec(job.request.sun, job.request.location, job.request.time);
   api::set_render_metadata(&snap.image, job.request, job.plan, sun,
-                           std::min(job.plan.samples_per_pixel,
-                                    job.merger->complete_passes() * job.plan.samples_per_pass),
+                           job.mean_samples_per_pixel(job.merger->complete_passes()),
                            job.merger->error_sums(job.sun_pixels));
   snap.exr.half = out.half;
   snap.exr.spectral_channels = out.spectral_channels;
@@ -616,6 +644,7 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
     if (!job.merger->received(u)) unit = u;
   }
   while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
+    if (job.waits_for_allocation() && unit_at(job.plan, job.cursor).pass > 0) break;
     const WorkUnit u = unit_at(job.plan, job.cursor++);
     if (!job.merger->received(u)) unit = u;
   }
@@ -632,7 +661,10 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
   impl_->in_flight[attempt] = InFlight{job.record.id, *unit, worker_id, Clock::now()};
   ++job.in_flight;
   if (auto w = workers.find(worker_id); w != workers.end()) ++w->second.in_flight;
-  return UnitAssignment{{job.record.id, unit->tile, unit->batch, unit->pass}, attempt, job.record.request};
+  UnitAssignment a{{job.record.id, unit->tile, unit->batch, unit->pass}, attempt, job.record.request};
+  if (unit->pass > 0 && job.allocation)
+    for (const PassSamples& n : job.allocation->tile(unit->tile)) a.samples_per_pass.emplace_back(n.even, n.odd);
+  return a;
 }
 
 // The pass of the unit a job would hand out next (requeued units first).
@@ -658,6 +690,79 @@ Job& JobService::Impl::lowest_pass_in_group(Job& chosen) {
   return *pick;
 }
 
+namespace {
+
+const char* kAllocationFile = "allocation.json";
+
+nlohmann::json allocation_json(const SampleAllocation& a) {
+  nlohmann::json tiles = nlohmann::json::array();
+  for (int t = 0; t < a.tile_count(); ++t) {
+    nlohmann::json blocks = nlohmann::json::array();
+    for (const PassSamples& n : a.tile(t)) blocks.push_back({n.even, n.odd});
+    tiles.push_back(std::move(blocks));
+  }
+  return {{"samples_per_pass", tiles}};
+}
+
+// The stored allocation, or nullopt when there is none or it does not fit the plan.
+std::optional<SampleAllocation> read_allocation(const fs::path& path, const RenderPlan& plan) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    std::vector<std::vector<PassSamples>> tiles;
+    for (const auto& blocks : j.at("samples_per_pass")) {
+      tiles.emplace_back();
+      for (const auto& n : blocks) tiles.back().push_back({n.at(0).get<int>(), n.at(1).get<int>()});
+    }
+    return SampleAllocation::from_counts(plan, std::move(tiles));
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+void write_allocation(const fs::path& path, const SampleAllocation& a) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << allocation_json(a).dump();
+    out.flush();
+    if (!out) throw StorageError("cannot write " + tmp.string());
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) throw StorageError("cannot write " + path.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+bool JobService::Impl::allocate(Job& job) {
+  const fs::path path = job.dir / kAllocationFile;
+  if (std::optional<SampleAllocation> stored = read_allocation(path, job.plan)) {
+    job.allocation = std::move(stored);
+    return true;
+  }
+  // Computed from the pilot alone: nothing beyond pass 0 may have been merged.
+  if (job.merger->merged_units() != job.plan.tile_count() * job.plan.batches) {
+    fail_job(job, "the adaptive sample allocation (" + path.string() + ") is missing or unreadable, and the pilot "
+                  "pass can no longer be told apart from later passes");
+    return false;
+  }
+  std::vector<SampleAllocation::BlockStatistics> rms(static_cast<std::size_t>(job.plan.tile_count()));
+  job.merger->visit_tiles([&](int t, const FilmTile& tile) {
+    rms[static_cast<std::size_t>(t)] = SampleAllocation::pilot_statistics(job.plan, t, tile, job.sun_pixels);
+  });
+  SampleAllocation a = SampleAllocation::from_statistics(job.plan, rms);
+  try {
+    write_allocation(path, a);
+  } catch (const StorageError& e) {
+    fail_job(job, e.what());
+    return false;
+  }
+  job.allocation = std::move(a);
+  return true;
+}
+
 void JobService::Impl::fail_job(Job& job, const std::string& message) {
   drop_attempts_of(job);
   job.stopped_by = "failed";
@@ -679,6 +784,7 @@ bool stops_early(const Job& job) {
 std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_complete(Job& job) {
   if (!job.active()) return std::nullopt;
   std::string stop;
+  if (job.waits_for_allocation() && job.merger->complete_passes() >= 1 && !allocate(job)) return std::nullopt;
   while (stop.empty()) {
     const int passes = job.merger->complete_passes();
     if (passes > job.passes_reported) {
@@ -688,7 +794,7 @@ std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_compl
       const auto rms_rgb = sums.relative_rms_rgb();
       job.history.push_back(
           {{"elapsed_s", job.elapsed_s()},
-           {"samples_per_pixel", std::min(job.plan.samples_per_pixel, passes * job.plan.samples_per_pass)},
+           {"samples_per_pixel", job.samples_per_pixel(passes)},
            {"estimated_relative_rms", rms ? nlohmann::json(*rms) : nlohmann::json(nullptr)},
            {"estimated_relative_rms_rgb", rms_rgb ? nlohmann::json{{"r", rms_rgb->r}, {"g", rms_rgb->g}, {"b", rms_rgb->b}}
                                                   : nlohmann::json(nullptr)},

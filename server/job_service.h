@@ -46,6 +46,9 @@ struct UnitAssignment {
   std::uint64_t attempt = 0;       // unique per dispatch; results of other attempts are dropped
   std::string request_canonical;   // api::canonical_text of the job's request (workers cache the setup per job)
   api::UnitKind kind = api::UnitKind::kRender;  // kProbe: a radiance probe's unit (server/probe_service.h)
+  // An adaptive job's samples per pass after its pilot, per allocation block
+  // of the tile, (even, odd) pixels (api::UnitMsg); empty: uniform.
+  std::vector<std::pair<int, int>> samples_per_pass;
 };
 
 // --- Errors the HTTP layer maps to status codes ------------------------------

@@ -16,6 +16,7 @@
 // film in the server's memory.
 #pragma once
 #include <filesystem>
+#include <functional>
 #include <list>
 #include <map>
 #include <memory>
@@ -64,6 +65,8 @@ class TileMerger {
 
   // Resolves every tile into `image` (sizes must match).
   void resolve(Image* image) const;
+  // Calls fn(t, sums) for every tile in order, one tile in memory at a time.
+  void visit_tiles(const std::function<void(int, const FilmTile&)>& fn) const;
   // ErrorSums::relative_rms: sqrt(sum_i var(Y_i) / sum_i Y_i^2) with the true
   // sum Y^2 estimated from the noisy means, over pixels with an estimate, or
   // nullopt; `excluded` are the sun disk's pixels (render/sun_pixels.h).

@@ -190,6 +190,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
   std::string only;
   IntegratorOptions options;
   std::optional<bool> roulette_control;  // the plan's choice unless given
+  bool adaptive = false;                  // variance-aware sample allocation (sample_allocation.h)
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--out" && i + 1 < args.size()) dir = args[++i];
     else if (args[i] == "--scene" && i + 1 < args.size()) only = args[++i];
@@ -213,11 +214,13 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       roulette_control = true;
     else if (args[i] == "--no-roulette-control")
       roulette_control = false;
+    else if (args[i] == "--adaptive")
+      adaptive = true;
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
                    "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n"
-                   "  [--roulette-control | --no-roulette-control] [--rr-start-depth D]\n";
+                   "  [--roulette-control | --no-roulette-control] [--rr-start-depth D] [--adaptive]\n";
       return 2;
     }
   }
@@ -228,6 +231,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     const auto request = api::parse_render_request(request_json(s, passes * 16, seed));
     api::RenderSetup setup = api::make_render_setup(request);
     if (roulette_control) setup.plan.roulette_control = *roulette_control;
+    setup.plan.adaptive = adaptive;
     const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan, options);
     const std::vector<bool> keep = sky_mask(setup);
     std::vector<double> times, truths, estimates;
@@ -258,6 +262,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
                                 {"samples_per_pixel", passes * 16},
                                 {"forced_collision_segments", options.forced_collision_segments},
                                 {"roulette_control", setup.plan.roulette_control},
+                                {"adaptive", adaptive},
                                 {"fitted_slope", fitted_slope(times, truths)},
                                 {"worst_estimate_ratio", worst},
                                 {"efficiency_1_over_err2_time", efficiency}}

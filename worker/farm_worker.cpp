@@ -87,9 +87,22 @@ api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
     if (u.tile >= plan.tile_count() || u.batch >= plan.batches || u.pass >= plan.passes)
       throw std::runtime_error("unit (tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) +
                                ", pass " + std::to_string(u.pass) + ") is outside the job's plan");
+    // An adaptive job's later passes need their counts, one per allocation
+    // block of the tile, and only they take any.
+    const bool counted = !task.samples_per_pass.empty();
+    if (counted != (plan.adaptive && u.pass > 0))
+      throw std::runtime_error("unit (tile " + std::to_string(u.tile) + ", pass " + std::to_string(u.pass) + ") " +
+                               (counted ? "has samples_per_pass, but its plan allocates none there"
+                                        : "of an adaptive plan after its pilot has no samples_per_pass"));
+    if (counted && static_cast<int>(task.samples_per_pass.size()) != plan.block_count(u.tile))
+      throw std::runtime_error("unit (tile " + std::to_string(u.tile) + ") has samples_per_pass for " +
+                               std::to_string(task.samples_per_pass.size()) + " blocks; the tile has " +
+                               std::to_string(plan.block_count(u.tile)));
+    WorkUnit unit{u.tile, u.batch, u.pass, {}};
+    for (const auto& [even, odd] : task.samples_per_pass) unit.samples.push_back({even, odd});
     FilmTile film = job->renderer->empty_tile(u.tile);
     PathCounters counters;
-    job->renderer->render_unit(WorkUnit{u.tile, u.batch, u.pass}, &film, &counters);
+    job->renderer->render_unit(unit, &film, &counters);
     const std::vector<std::uint8_t> bytes = film.serialize();
     const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     return api::ResultMsg{u, counters.paths, seconds, std::string(bytes.begin(), bytes.end())};

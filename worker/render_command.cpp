@@ -83,15 +83,18 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   ProgressDisplay progress(label);
   const auto on_progress = [&](int done, int total) { progress.update(done, total); };
   LocalRenderResult result;
-  int samples = plan.samples_per_pixel;
+  double samples = plan.samples_per_pixel;
   std::string stopped_by = "samples";
-  if (request.quality.target_relative_error || request.quality.time_limit_s) {
-    // Pass by pass over the whole frame, stopping like the farm does.
+  if (request.quality.target_relative_error || request.quality.time_limit_s || plan.adaptive) {
+    // Pass by pass over the whole frame, stopping (and allocating) like the farm does.
     const ProgressiveResult r = render_image_progressive(
         renderer, &image, threads, {request.quality.target_relative_error, request.quality.time_limit_s, {}}, on_progress);
     result = r;
-    samples = std::min(plan.samples_per_pixel, r.passes * plan.samples_per_pass);
+    samples = r.samples_per_pixel;
     stopped_by = r.stopped_by;
+    if (r.allocation)
+      std::fprintf(stderr, "%s: adaptive samples per pass %d-%d after the pilot\n", label.c_str(),
+                   r.allocation->min_samples_per_pass(), r.allocation->max_samples_per_pass());
   } else {
     result = render_image(renderer, &image, threads, on_progress);
   }
@@ -120,7 +123,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   const double paths = static_cast<double>(result.counters.paths);
   const Rgb e_rgb = result.error.relative_rms_rgb().value_or(Rgb{0.0, 0.0, 0.0});
   std::printf("time %.2f s, %.0f paths, %.3g paths/s (%.3g per thread), estimated relative RMS error %.4f "
-              "(R %.4f, G %.4f, B %.4f), %d samples per pixel, stopped by %s\n",
+              "(R %.4f, G %.4f, B %.4f), %.4g samples per pixel, stopped by %s\n",
               seconds, paths, paths / seconds, paths / seconds / resolve_thread_count(threads),
               result.estimated_relative_rms, e_rgb.r, e_rgb.g, e_rgb.b, samples, stopped_by.c_str());
   if (result.counters.nonfinite > 0)

@@ -14,6 +14,8 @@ namespace skyfarm {
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,
                                const RenderProgress& progress) {
   const RenderPlan& plan = renderer.plan();
+  // An adaptive plan's tiles wait for the whole frame's pilot.
+  if (plan.adaptive) return render_image_progressive(renderer, image, threads, StopCriteria{}, progress);
   const int tiles = plan.tile_count();
   struct TileStats {
     PathCounters counters;
@@ -61,8 +63,10 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
   for (int p = 0; p < plan.passes; ++p) {
     parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
       FilmTile pass = renderer.empty_tile(static_cast<int>(t));
+      const std::vector<PassSamples> samples =
+          r.allocation && p > 0 ? r.allocation->tile(static_cast<int>(t)) : std::vector<PassSamples>{};
       for (int b = 0; b < plan.batches; ++b)
-        renderer.render_unit({static_cast<int>(t), b, p}, &pass, &counters[t]);
+        renderer.render_unit({static_cast<int>(t), b, p, samples}, &pass, &counters[t]);
       film[t].merge(pass);
       if (progress) {
         const std::lock_guard<std::mutex> lock(mutex);
@@ -70,6 +74,9 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       }
     });
     r.passes = p + 1;
+    if (p == 0 && plan.adaptive) r.allocation = SampleAllocation::from_pilot(plan, film, renderer.sun_pixels());
+    r.samples_per_pixel = r.allocation ? r.allocation->mean_samples_per_pixel(plan, r.passes)
+                                       : std::min(plan.samples_per_pixel, r.passes * plan.samples_per_pass);
     ErrorSums error;
     for (const auto& tile : film) error.add(error_sums(tile, renderer.sun_pixels(), plan.width));  // tile order
     r.estimate = error.relative_rms();

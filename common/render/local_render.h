@@ -13,6 +13,7 @@
 
 #include "common/film/error_estimate.h"
 #include "common/film/image.h"
+#include "common/render/sample_allocation.h"
 #include "common/render/tile_renderer.h"
 
 namespace skyfarm {
@@ -43,12 +44,14 @@ struct StopCriteria {
 
 struct ProgressiveResult : LocalRenderResult {
   int passes = 0;             // passes rendered (every tile)
+  double samples_per_pixel = 0.0;               // the mean over the rendered pixels
+  std::optional<SampleAllocation> allocation;   // adaptive plans, after the pilot
   std::string stopped_by;     // "samples", "target_error" or "time_limit"
   std::vector<std::pair<double, double>> history;  // (elapsed s, estimate) after each pass
 };
 
 // Renders pass by pass over the whole frame (all tiles of pass p before any
-// of pass p + 1) and stops by `stop`; the same passes and stopping rule as the
+// of pass p + 1; an adaptive plan's allocation from pass 0, the pilot) and stops by `stop`; the same passes and stopping rule as the
 // farm, so the same request gives the same bytes.  Keeps the whole film in
 // memory (width x height x batches x 48 bytes), unlike render_image().
 ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* image, int threads,

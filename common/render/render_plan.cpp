@@ -21,6 +21,39 @@ int RenderPlan::pass_end_sample(int pass) const {
   return std::min(samples_per_pixel, (pass + 1) * samples_per_pass);
 }
 
+int RenderPlan::blocks_x(int tile) const {
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  tile_rect(tile, &x0, &y0, &w, &h);
+  return (w + kAllocationBlock - 1) / kAllocationBlock;
+}
+
+int RenderPlan::block_count(int tile) const {
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  tile_rect(tile, &x0, &y0, &w, &h);
+  return ((w + kAllocationBlock - 1) / kAllocationBlock) * ((h + kAllocationBlock - 1) / kAllocationBlock);
+}
+
+int RenderPlan::block_of(int tile, int x, int y) const {
+  const int tx = tile % tiles_x, ty = tile / tiles_x;
+  return ((y - ty * tile_size) / kAllocationBlock) * blocks_x(tile) + (x - tx * tile_size) / kAllocationBlock;
+}
+
+void RenderPlan::sample_range(const WorkUnit& u, int x, int y, int* first, int* end) const {
+  *first = pass_first_sample(u.pass);
+  *end = pass_end_sample(u.pass);
+  const int n = u.pass > 0 && !u.samples.empty() ? u.samples[static_cast<std::size_t>(block_of(u.tile, x, y))].of(x, y) : 0;
+  if (n <= 0) return;
+  *first = samples_per_pass + (u.pass - 1) * n;
+  *end = *first + allocated_samples(u.pass, n);
+}
+
+// A short last pass keeps its share of n.
+int RenderPlan::allocated_samples(int pass, int n) const {
+  const int length = pass_end_sample(pass) - pass_first_sample(pass);
+  if (length == samples_per_pass) return n;
+  return std::max(1, static_cast<int>(std::lround(static_cast<double>(n) * length / samples_per_pass)));
+}
+
 double RenderPlan::batch_min_nm(int batch) const { return batch_edge_nm(lambda_min_nm, lambda_max_nm, batch, batches); }
 double RenderPlan::batch_max_nm(int batch) const {
   return batch_edge_nm(lambda_min_nm, lambda_max_nm, batch + 1, batches);

@@ -11,6 +11,12 @@
 // by (seed of batch b, pixel index y W + x, sample index, dimension).  Units
 // of one tile are merged in pass order (then batch order), so the sums are
 // bit-identical however the units were scheduled.
+//
+// Adaptive plans (sample_allocation.h): pass 0 is the uniform pilot; a unit
+// of a later pass carries, for each kAllocationBlock-square block of its
+// tile, the samples per pass n of the even and odd pixels (parity of x + y),
+// and renders samples [S + (p - 1) n, S + p n) of each pixel (sample_range; a
+// short last pass in proportion).
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -19,8 +25,19 @@
 
 namespace skyfarm {
 
+// Samples per pixel per pass by the parity of x + y; 0 = the plan's uniform count.
+struct PassSamples {
+  int even = 0, odd = 0;
+  int of(int x, int y) const { return ((x + y) & 1) != 0 ? odd : even; }
+  bool uniform() const { return even == 0 && odd == 0; }
+  bool operator==(const PassSamples&) const = default;
+};
+
 struct WorkUnit {
   int tile = 0, batch = 0, pass = 0;
+  // Adaptive plans, passes >= 1 (sample_allocation.h): the samples per pass
+  // of each allocation block of the tile (RenderPlan::block_of); empty = uniform.
+  std::vector<PassSamples> samples{};
 };
 
 struct RenderPlan {
@@ -47,6 +64,11 @@ struct RenderPlan {
   // docs/physics.md, "Roulette with a control variate").
   bool roulette_control = false;
   static constexpr double kRouletteControlMaxSunZenith_deg = 85.0;
+  // Variance-aware sample allocation after a uniform pilot pass
+  // (sample_allocation.h): path-traced plans of two passes or more whose
+  // request asks for it ("quality.adaptive").
+  bool adaptive = false;
+  static constexpr int kAllocationBlock = 8;
   int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }
@@ -56,6 +78,16 @@ struct RenderPlan {
   // Samples [first, end) of pass p.
   int pass_first_sample(int pass) const { return pass * samples_per_pass; }
   int pass_end_sample(int pass) const;
+  // Allocation blocks of tile t (row-major, kAllocationBlock pixels square,
+  // edge blocks smaller), and the block of pixel (x, y) of that tile.
+  int blocks_x(int tile) const;
+  int block_count(int tile) const;
+  int block_of(int tile, int x, int y) const;
+  // Samples [*first, *end) of pixel (x, y) in unit u (the pass's uniform
+  // range, or u.samples' count for the pixel's parity after the pilot).
+  void sample_range(const WorkUnit& u, int x, int y, int* first, int* end) const;
+  // Samples in pass p >= 1 of a pixel allocated n per pass.
+  int allocated_samples(int pass, int n) const;
   // Wavelength range of batch b (shared edges are bit-identical).
   double batch_min_nm(int batch) const;
   double batch_max_nm(int batch) const;

@@ -100,7 +100,9 @@ void TileRenderer::render_unit(const WorkUnit& unit, FilmTile* film, PathCounter
       if (!camera_.pixel_exists(x, y)) continue;
       const std::uint64_t pixel = static_cast<std::uint64_t>(y) * static_cast<std::uint64_t>(plan_.width) +
                                   static_cast<std::uint64_t>(x);
-      for (int s = plan_.pass_first_sample(unit.pass); s < plan_.pass_end_sample(unit.pass); ++s) {
+      int first = 0, end = 0;
+      plan_.sample_range(unit, x, y, &first, &end);
+      for (int s = first; s < end; ++s) {
         Sampler sampler(seed, pixel, static_cast<std::uint64_t>(s));
         const double jx = sampler.next(), jy = sampler.next();
         Ray ray;

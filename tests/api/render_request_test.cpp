@@ -291,7 +291,7 @@ TEST(RenderRequestErrors, UnknownFieldsAreRejectedAtEveryLevel) {
             "colour: unknown field (allowed: location, time, sun, camera, atmosphere, spectral, quality, method, "
             "output, seed, priority)"},
            {with(R"("quality": {"spp": 4})"),
-            "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s)"},
+            "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s, adaptive)"},
            {with(R"("output": {"png": true})"),
             "output.png: unknown field (allowed: exposure_ev, spectral_channels, error_layer, half)"},
            {with(R"("spectral": {"step_nm": 5})"), "spectral.step_nm: unknown field (allowed: min_nm, max_nm, batches)"},
@@ -588,6 +588,22 @@ TEST(RenderRequestCanonical, EveryFieldIsPresent) {
   EXPECT_EQ(c["seed"], 1u);
   EXPECT_EQ(c["sun"]["angular_radius_deg"], 0.2666);
   EXPECT_TRUE(c["sun"]["irradiance"].is_null());
+}
+
+// "quality.adaptive" (sample_allocation.h) is in the canonical text only
+// when true, so requests written before it keep their text and hash.
+TEST(RenderRequestCanonical, AdaptiveOnlyWhenAsked) {
+  const RenderRequest plain = parse_render_request(with(R"("quality": {"samples_per_pixel": 64})"));
+  EXPECT_FALSE(plain.quality.adaptive);
+  EXPECT_FALSE(to_canonical_json(plain)["quality"].contains("adaptive"));
+  EXPECT_EQ(canonical_text(plain), canonical_text(parse_render_request(with(R"("quality": {"adaptive": false})"))));
+  const RenderRequest adaptive = parse_render_request(with(R"("quality": {"adaptive": true})"));
+  EXPECT_TRUE(adaptive.quality.adaptive);
+  EXPECT_EQ(to_canonical_json(adaptive)["quality"]["adaptive"], true);
+  EXPECT_EQ(parse_render_request(canonical_text(adaptive)).quality.adaptive, true);
+  const std::vector<FieldError> errors = errors_of(with(R"("quality": {"adaptive": "yes"})"));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].path, "quality.adaptive");
 }
 
 TEST(RenderRequestCanonical, CustomAtmosphereKeepsOnlyItsFields) {

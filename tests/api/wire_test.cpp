@@ -54,6 +54,24 @@ TEST(WireTest, UnitKindTravelsAndRenderUnitsAreUnchanged) {
   EXPECT_THROW(decode({"UNIT", header + "7}"}), WireError);
 }
 
+// An adaptive render unit carries its tile's samples per pass per allocation
+// block, as [even, odd] pairs; a uniform unit's header has none; counts out
+// of range or of the wrong shape are refused.
+TEST(WireTest, AdaptiveSamplesPerPassTravelAndAreChecked) {
+  UnitMsg adaptive{sample_ref(), "{}"};
+  adaptive.samples_per_pass = {{4, 64}, {16, 17}, {1, 1}};
+  expect_round_trip(adaptive);
+  const Frames frames = encode(adaptive);
+  EXPECT_NE(frames[1].find(R"("samples_per_pass":[[4,64],[16,17],[1,1]])"), std::string::npos) << frames[1];
+  EXPECT_EQ(encode(UnitMsg{sample_ref(), "{}"})[1].find("samples_per_pass"), std::string::npos);
+  const std::string header = R"({"job": "j", "tile": 0, "batch": 0, "pass": 1, "attempt": 1, "request": "{}", )";
+  for (const char* bad : {R"("samples_per_pass": []})", R"("samples_per_pass": [[4]]})",
+                          R"("samples_per_pass": [[4, 0]]})", R"("samples_per_pass": [[4, 2.5]]})",
+                          R"("samples_per_pass": [[4, 2000000]]})", R"("samples_per_pass": [4, 5]})",
+                          R"("samples_per_pass": {"even": 4}})"})
+    EXPECT_THROW(decode({"UNIT", header + bad}), WireError) << bad;
+}
+
 TEST(WireTest, ResultPayloadIsABinaryFrameNotJson) {
   const Frames f = encode(ResultMsg{sample_ref(), 1, 0.5, std::string("\0\1\2", 3)});
   ASSERT_EQ(f.size(), 3u);

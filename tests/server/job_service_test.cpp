@@ -52,7 +52,9 @@ std::vector<std::uint8_t> render_assignment(const UnitAssignment& a) {
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   FilmTile film = renderer.empty_tile(a.key.tile);
   PathCounters counters;
-  renderer.render_unit({a.key.tile, a.key.batch, a.key.pass}, &film, &counters);
+  WorkUnit unit{a.key.tile, a.key.batch, a.key.pass, {}};
+  for (const auto& [even, odd] : a.samples_per_pass) unit.samples.push_back({even, odd});
+  renderer.render_unit(unit, &film, &counters);
   return film.serialize();
 }
 
@@ -432,6 +434,87 @@ TEST(JobService, LutJobIsOnePassApproximateAndMatchesTheLocalRender) {
   EXPECT_EQ(s["progress"]["samples_per_pixel"], 1);
   EXPECT_TRUE(s["error"]["estimated_relative_rms"].is_null()) << "a LUT render has no Monte Carlo estimate";
   EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kLut));
+}
+
+// "quality.adaptive": pass 0 is a uniform pilot; no unit of a later pass is
+// handed out before the pilot is merged everywhere; later units carry their
+// tile's samples per allocation block; the EXR equals the local render's,
+// also across a restart that resumes with the stored allocation.
+constexpr const char* kAdaptive = R"({
+  "sun": {"zenith_deg": 80, "azimuth_deg": 100},
+  "camera": {"projection": "equirectangular", "width": 64, "height": 48},
+  "spectral": {"batches": 2},
+  "quality": {"samples_per_pixel": 40, "adaptive": true},
+  "output": {"half": false},
+  "seed": 7
+})";
+
+TEST(JobService, AdaptiveJobAllocatesAfterItsPilotAndMatchesTheLocalRender) {
+  const fs::path dir = fresh_dir("adaptive");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kAdaptive), std::nullopt).id;
+  EXPECT_EQ((*service.status(id))["plan"]["adaptive"], true);
+  const int pilot_units = 4 * 2;  // 2 x 2 tiles x 2 batches
+  std::vector<UnitAssignment> pilot;
+  while (auto a = service.next_unit("w")) pilot.push_back(*a);
+  ASSERT_EQ(static_cast<int>(pilot.size()), pilot_units) << "later passes wait for the allocation";
+  for (const auto& a : pilot) {
+    EXPECT_EQ(a.key.pass, 0);
+    EXPECT_TRUE(a.samples_per_pass.empty());
+  }
+  for (const auto& a : pilot) service.unit_done("w", a.key, a.attempt, render_assignment(a), 1);
+  const auto after_pilot = *service.status(id);
+  ASSERT_TRUE(after_pilot["plan"].contains("samples_per_pass_after_pilot"));
+  EXPECT_LT(after_pilot["plan"]["samples_per_pass_after_pilot"]["min"].get<int>(),
+            after_pilot["plan"]["samples_per_pass_after_pilot"]["max"].get<int>());
+  EXPECT_TRUE(fs::exists(dir / "jobs" / id / "allocation.json"));
+  const auto next = service.next_unit("w");
+  ASSERT_TRUE(next);
+  EXPECT_EQ(next->key.pass, 1);
+  EXPECT_EQ(next->samples_per_pass.size(), 16u) << "4 x 4 blocks of 8 pixels per 32-pixel tile";
+  service.unit_done("w", next->key, next->attempt, render_assignment(*next), 1);
+  std::mt19937 rng(8);
+  run_shuffled(service, rng, 5);
+  const auto done = *service.status(id);
+  ASSERT_EQ(done["state"], "done");
+  EXPECT_NEAR(done["progress"]["samples_per_pixel"].get<double>(), 40.0, 1.5) << "the mean stays the request's";
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kAdaptive));
+}
+
+TEST(JobService, AdaptiveJobResumesWithItsStoredAllocation) {
+  const fs::path dir = fresh_dir("adaptive_restart");
+  std::string id;
+  {
+    JobService service(dir);
+    id = service.submit(api::parse_render_request(kAdaptive), std::nullopt).id;
+    // The pilot and two units of pass 1, one more left in flight.
+    for (int i = 0; i < 11; ++i) {
+      const auto a = service.next_unit("w");
+      ASSERT_TRUE(a);
+      if (i < 10) service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+    }
+  }
+  JobService restarted(dir);
+  EXPECT_TRUE((*restarted.status(id))["plan"].contains("samples_per_pass_after_pilot"));
+  std::mt19937 rng(10);
+  run_shuffled(restarted, rng, 3);
+  ASSERT_EQ((*restarted.status(id))["state"], "done");
+  EXPECT_EQ(read_file(restarted.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kAdaptive));
+  // Without its allocation the job cannot tell its pilot from later passes: it fails, saying why.
+  const std::string lost_id = [&] {
+    JobService service(dir / "lost");
+    const std::string j = service.submit(api::parse_render_request(kAdaptive), std::nullopt).id;
+    for (int i = 0; i < 10; ++i) {
+      const auto a = service.next_unit("w");
+      service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+    }
+    return j;
+  }();
+  fs::remove(dir / "lost" / "jobs" / lost_id / "allocation.json");
+  JobService lost(dir / "lost");
+  const auto s = *lost.status(lost_id);
+  EXPECT_EQ(s["state"], "failed");
+  EXPECT_NE(s["failure"].get<std::string>().find("allocation"), std::string::npos) << s["failure"];
 }
 
 }  // namespace
