@@ -28,7 +28,7 @@ std::vector<PassSamples> block_pixels(const RenderPlan& plan, int t) {
 // m_g, RMS s_g), with k such that sum m_g n_g = S sum m_g (bisection: the sum
 // is monotone in k); before rounding.
 std::vector<double> normalised_counts(const std::vector<double>& s, const std::vector<int>& m, double S) {
-  const double lo = S / SampleAllocation::kMaxRatio, hi = S * SampleAllocation::kMaxRatio;
+  const double lo = S / SampleAllocation::kMinRatio, hi = S * SampleAllocation::kMaxRatio;
   double sum_m = 0.0, sum_ms = 0.0;
   for (std::size_t g = 0; g < s.size(); ++g) {
     sum_m += m[g];
