@@ -119,7 +119,7 @@ struct UnitMsg {
   std::string request;  // canonical request text
   UnitKind kind = UnitKind::kRender;
   // samples_per_pass: per allocation block of the tile, (even, odd); empty: absent (uniform).
-  std::vector<std::pair<int, int>> samples_per_pass;
+  std::vector<std::pair<int, int>> samples_per_pass{};
   bool operator==(const UnitMsg&) const = default;
 };
 

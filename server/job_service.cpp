@@ -56,6 +56,18 @@ WorkUnit unit_at(const RenderPlan& plan, std::size_t i) {
                   static_cast<int>(rem % static_cast<std::size_t>(plan.batches)), static_cast<int>(i / per_pass)};
 }
 
+// The queue's measure of a job (ServiceLimits::max_queue_units): its units
+// not yet merged, at most kQueueHorizonPasses passes' worth.  Units are made
+// on demand from a cursor, so a far pass waits nowhere; and a request that
+// stops by a target error or a time limit alone has no sample cap (1048576
+// samples per pixel: 65536 passes), which counted whole made "1 % in at most
+// 2 minutes" of a 512x256 frame 4.2 million units, over the limit.
+constexpr std::int64_t kQueueHorizonPasses = 16;
+std::int64_t waiting_units(const RenderPlan& plan, std::int64_t merged) {
+  const std::int64_t per_pass = static_cast<std::int64_t>(plan.tile_count()) * plan.batches;
+  return std::max<std::int64_t>(0, std::min(plan.unit_count() - merged, per_pass * kQueueHorizonPasses));
+}
+
 std::string unit_text(const WorkUnit& u) {
   return "tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) + ", pass " + std::to_string(u.pass);
 }
@@ -319,16 +331,23 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
     }
   }
   int active = 0;
-  long long queued_units = 0;
+  std::int64_t queued_units = 0;
   for (const auto& [id, job] : impl_->jobs) {
     if (!job->active()) continue;
     ++active;
-    queued_units += job->plan.unit_count() - job->merger->merged_units();
+    queued_units += waiting_units(job->plan, job->merger->merged_units());
   }
   if (active >= impl_->limits.max_active_jobs)
     throw CapacityExceeded("too many active jobs (" + std::to_string(active) + "); try again later");
   const RenderPlan plan = api::render_plan_for(request, Sun::from_spec(request.sun, request.location, request.time));
-  if (queued_units + plan.unit_count() > impl_->limits.max_queue_units)
+  const std::int64_t units = waiting_units(plan, 0);
+  if (units > impl_->limits.max_queue_units)
+    throw CapacityExceeded("this render alone is " + std::to_string(units) + " units of work (" +
+                           std::to_string(plan.tile_count()) + " tiles x " + std::to_string(plan.batches) +
+                           " batches x " + std::to_string(std::min<std::int64_t>(plan.passes, kQueueHorizonPasses)) +
+                           " passes), more than the queue's " + std::to_string(impl_->limits.max_queue_units) +
+                           "; fewer pixels, batches or samples_per_pixel");
+  if (queued_units + units > impl_->limits.max_queue_units)
     throw CapacityExceeded("the queue is full (" + std::to_string(queued_units) + " units waiting); try again later");
 
   JobRecord r;
@@ -562,11 +581,11 @@ nlohmann::json JobService::workers() const {
 
 nlohmann::json JobService::metrics() const {
   const std::lock_guard<std::mutex> lock(impl_->mu);
-  long long queue_units = 0;
+  std::int64_t queue_units = 0;
   int queued = 0, running = 0, done = 0, failed = 0;
   for (const auto& [id, job] : impl_->jobs) {
     const std::string& s = job->record.state;
-    if (job->active()) queue_units += job->plan.unit_count() - job->merger->merged_units() - job->in_flight;
+    if (job->active()) queue_units += waiting_units(job->plan, job->merger->merged_units()) - job->in_flight;
     queued += s == "queued";
     running += s == "running";
     done += s == "done";

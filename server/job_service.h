@@ -48,7 +48,7 @@ struct UnitAssignment {
   api::UnitKind kind = api::UnitKind::kRender;  // kProbe: a radiance probe's unit (server/probe_service.h)
   // An adaptive job's samples per pass after its pilot, per allocation block
   // of the tile, (even, odd) pixels (api::UnitMsg); empty: uniform.
-  std::vector<std::pair<int, int>> samples_per_pass;
+  std::vector<std::pair<int, int>> samples_per_pass{};
 };
 
 // --- Errors the HTTP layer maps to status codes ------------------------------
@@ -100,7 +100,7 @@ struct JobSummary {
 
 struct ServiceLimits {
   int max_active_jobs = 64;       // queued + running
-  int max_queue_units = 4000000;  // units waiting over all jobs
+  int max_queue_units = 4000000;  // units waiting over all jobs (at most 16 passes of each)
   double unit_timeout_s = 120.0;  // a dispatched unit with no result after this is requeued
   int max_unit_failures = 3;      // distinct workers failing a unit fails its job
 };

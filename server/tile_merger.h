@@ -56,8 +56,8 @@ class TileMerger {
   // Forgets results waiting in memory (a job stopped early).
   void drop_waiting();
 
-  int merged_units() const { return merged_units_; }
-  int total_units() const { return plan_.unit_count(); }
+  std::int64_t merged_units() const { return merged_units_; }
+  std::int64_t total_units() const { return plan_.unit_count(); }
   bool complete() const { return merged_units_ == total_units(); }
   // Passes merged in every tile (all batches).
   int complete_passes() const;
@@ -96,7 +96,7 @@ class TileMerger {
   mutable std::size_t cached_bytes_ = 0;
   std::vector<int> next_index_;                   // per tile: units merged
   std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
-  int merged_units_ = 0;
+  std::int64_t merged_units_ = 0;
   int pass_limit_ = 1 << 30;
 };
 

@@ -72,7 +72,11 @@ struct RenderPlan {
   int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }
-  int unit_count() const { return tile_count() * batches * passes; }
+  // 64-bit: a 16384 x 8192 frame with no sample cap (a target error or time
+  // limit alone) has 131072 tiles x 65536 passes.
+  std::int64_t unit_count() const {
+    return static_cast<std::int64_t>(tile_count()) * batches * static_cast<std::int64_t>(passes);
+  }
   // Pixel rectangle of tile t.
   void tile_rect(int tile, int* x0, int* y0, int* w, int* h) const;
   // Samples [first, end) of pass p.

@@ -517,5 +517,38 @@ TEST(JobService, AdaptiveJobResumesWithItsStoredAllocation) {
   EXPECT_NE(s["failure"].get<std::string>().find("allocation"), std::string::npos) << s["failure"];
 }
 
+// The queue limit counts at most 16 passes of a job: "1 % in at most 2
+// minutes" (no sample cap: 65536 passes) of a 512x256 frame is accepted; a
+// render that alone exceeds the limit is refused, saying so.  Unit counts
+// are 64-bit: 16384 x 8192 with no sample cap is 8.6e9 units.
+TEST(JobService, OpenEndedRendersFitTheQueueAndAnOversizedOneIsRefusedByName) {
+  const fs::path dir = fresh_dir("queue");
+  ServiceLimits limits;
+  limits.max_queue_units = 5000;
+  JobService service(dir, limits);
+  const auto open_ended = service.submit(api::parse_render_request(R"({
+    "sun": {"zenith_deg": 30, "azimuth_deg": 180},
+    "camera": {"projection": "equirectangular", "width": 512, "height": 256},
+    "quality": {"target_relative_error": 0.01, "time_limit_s": 120}})"), std::nullopt);
+  EXPECT_TRUE(open_ended.created);
+  const auto s = *service.status(open_ended.id);
+  EXPECT_EQ(s["plan"]["passes"], 65536);
+  EXPECT_EQ(s["progress"]["units_total"].get<std::int64_t>(), 64LL * 65536);
+  // 1024 units waiting (16 passes of 64 tiles) and 128 more fit under 5000.
+  EXPECT_TRUE(service.submit(api::parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 10},
+      "camera": {"projection": "equirectangular", "width": 256, "height": 128}})"), std::nullopt).created);
+  const auto huge = api::parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 10},
+    "camera": {"projection": "equirectangular", "width": 16384, "height": 8192},
+    "quality": {"target_relative_error": 0.01}})");
+  EXPECT_EQ(api::render_plan_for(huge, Sun::from_spec(huge.sun, huge.location, huge.time)).unit_count(),
+            131072LL * 65536);
+  try {
+    service.submit(huge, std::nullopt);
+    FAIL() << "2 million units waiting is over the limit of 5000";
+  } catch (const CapacityExceeded& e) {
+    EXPECT_NE(std::string(e.what()).find("this render alone"), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace skyfarm::server
