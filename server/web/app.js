@@ -196,6 +196,10 @@ function setPath(object, path, value) {
 function readRequest() {
   const body = { camera: {} };
   for (const input of form.querySelectorAll("[data-type]")) {
+    if (input.dataset.type === "boolean") {  // a checkbox: sent only when checked
+      if (!input.disabled && input.checked) setPath(body, input.dataset.field, true);
+      continue;
+    }
     if (input.disabled || (input.value === "" && !input.validity.badInput)) continue;
     if (input.dataset.type === "string") { setPath(body, input.dataset.field, input.value); continue; }
     if (input.validity.badInput || !Number.isFinite(input.valueAsNumber))

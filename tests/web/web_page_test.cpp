@@ -98,7 +98,8 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
 
   // A small render: Paris at 13:50 local time (UTC+2 in June), 32x16; 256
   // samples (16 passes, about a second of work) so that it is still running
-  // when the page subscribes to its events.
+  // when the page subscribes to its events; "more samples where the noise
+  // is" ticked.
   driver.type("#latitude", "48.85");
   driver.type("#longitude", "2.35");
   set_value(driver, "#time-local", "2021-06-21T13:50");
@@ -107,6 +108,7 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   driver.type("#width", "32");
   driver.type("#height", "16");
   driver.type("#spp", "256");
+  driver.execute("document.querySelector('#adaptive').click();");  // variance-aware sample allocation
   driver.send_keys(driver.find("#spp"), "\xEE\x80\x87");  // U+E007 Enter: the keyboard submits the form
 
   const bool shown = driver.wait_until(
@@ -142,7 +144,8 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   // The farm agrees: that job, with the request the form described.
   const nlohmann::json status = server.status(id);
   EXPECT_EQ(status["state"], "done") << status.dump();
-  EXPECT_EQ(status["progress"]["samples_per_pixel"], 256);
+  EXPECT_EQ(status["plan"]["adaptive"], true) << "the checkbox asked for it";
+  EXPECT_NEAR(status["progress"]["samples_per_pixel"].get<double>(), 256.0, 4.0) << "the mean over the pixels";
 
   // The render list (refreshed by the page) has the job, done; the worker list a worker.
   const std::string row = js_string("#jobs-body tr[data-key=\"" + id + "\"]");
