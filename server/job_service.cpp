@@ -172,12 +172,92 @@ struct Job {
     return cursor < static_cast<std::size_t>(plan.unit_count()) &&
            !(waits_for_allocation() && unit_at(plan, cursor).pass > 0);
   }
+  // Run time, including what the job ran before a restart (report.json).
+  double elapsed_before_s = 0.0;
   double elapsed_s() const {
-    if (!started) return 0.0;
+    if (!started) return elapsed_before_s;
     const auto end = is_terminal(record.state) ? end_time : Clock::now();
-    return std::chrono::duration<double>(end - start_time).count();
+    return elapsed_before_s + std::chrono::duration<double>(end - start_time).count();
   }
 };
+
+namespace {
+
+const char* kAllocationFile = "allocation.json";
+const char* kReportFile = "report.json";
+
+// Writes `text` to `path` through a temporary file and a rename (readers and
+// a crash see the old or the new file, never half of one).
+bool write_atomically(const fs::path& path, const std::string& text) {
+  const fs::path tmp = path.string() + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::trunc);
+    out << text;
+    out.flush();
+    if (!out) return false;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  return !ec;
+}
+
+// What the status reports beyond the merged tiles, kept in the job's
+// directory so that a restart does not lose it: the error history, what
+// stopped the job, and its run time so far.  Best effort: a job whose report
+// cannot be written still renders (its tiles are the data).
+void write_report(const Job& job) {
+  if (!fs::exists(job.dir)) return;
+  const nlohmann::json report = {{"history", job.history},
+                                 {"stopped_by", job.stopped_by},
+                                 {"elapsed_s", job.elapsed_s()}};
+  write_atomically(job.dir / kReportFile, report.dump());
+}
+
+void read_report(Job& job) {
+  std::ifstream in(job.dir / kReportFile);
+  if (!in) return;
+  try {
+    const nlohmann::json r = nlohmann::json::parse(in);
+    if (r.at("history").is_array()) job.history = r.at("history");
+    job.stopped_by = r.at("stopped_by").get<std::string>();
+    job.elapsed_before_s = std::max(0.0, r.at("elapsed_s").get<double>());
+  } catch (const std::exception&) {
+    // An unreadable report: the status starts again from the tiles.
+  }
+}
+
+nlohmann::json allocation_json(const SampleAllocation& a) {
+  nlohmann::json tiles = nlohmann::json::array();
+  for (int t = 0; t < a.tile_count(); ++t) {
+    nlohmann::json blocks = nlohmann::json::array();
+    for (const PassSamples& n : a.tile(t)) blocks.push_back({n.even, n.odd});
+    tiles.push_back(std::move(blocks));
+  }
+  return {{"samples_per_pass", tiles}};
+}
+
+// The stored allocation, or nullopt when there is none or it does not fit the plan.
+std::optional<SampleAllocation> read_allocation(const fs::path& path, const RenderPlan& plan) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    std::vector<std::vector<PassSamples>> tiles;
+    for (const auto& blocks : j.at("samples_per_pass")) {
+      tiles.emplace_back();
+      for (const auto& n : blocks) tiles.back().push_back({n.at(0).get<int>(), n.at(1).get<int>()});
+    }
+    return SampleAllocation::from_counts(plan, std::move(tiles));
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+void write_allocation(const fs::path& path, const SampleAllocation& a) {
+  if (!write_atomically(path, allocation_json(a).dump())) throw StorageError("cannot write " + path.string());
+}
+
+}  // namespace
 
 struct InFlight {
   std::string job_id;
@@ -277,6 +357,8 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
   job->dir = data_dir / "jobs" / record.id;
   job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
   job->passes_reported = job->merger->complete_passes();
+  read_report(*job);
+  if (job->plan.adaptive) job->allocation = read_allocation(job->dir / kAllocationFile, job->plan);
   if (request.quality.target_relative_error || request.quality.time_limit_s)
     job->merger->set_pass_limit(job->merger->complete_passes() + 1);
   job->record = std::move(record);
@@ -293,6 +375,7 @@ void JobService::Impl::set_state(Job& job, const std::string& state, const std::
   job.record.state = state;
   job.record.failure = failure;
   if (is_terminal(state)) job.end_time = Clock::now();
+  write_report(job);
   if (state_observer) state_observer(job.record.id, state);
 }
 
@@ -709,51 +792,6 @@ Job& JobService::Impl::lowest_pass_in_group(Job& chosen) {
   return *pick;
 }
 
-namespace {
-
-const char* kAllocationFile = "allocation.json";
-
-nlohmann::json allocation_json(const SampleAllocation& a) {
-  nlohmann::json tiles = nlohmann::json::array();
-  for (int t = 0; t < a.tile_count(); ++t) {
-    nlohmann::json blocks = nlohmann::json::array();
-    for (const PassSamples& n : a.tile(t)) blocks.push_back({n.even, n.odd});
-    tiles.push_back(std::move(blocks));
-  }
-  return {{"samples_per_pass", tiles}};
-}
-
-// The stored allocation, or nullopt when there is none or it does not fit the plan.
-std::optional<SampleAllocation> read_allocation(const fs::path& path, const RenderPlan& plan) {
-  std::ifstream in(path);
-  if (!in) return std::nullopt;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(in);
-    std::vector<std::vector<PassSamples>> tiles;
-    for (const auto& blocks : j.at("samples_per_pass")) {
-      tiles.emplace_back();
-      for (const auto& n : blocks) tiles.back().push_back({n.at(0).get<int>(), n.at(1).get<int>()});
-    }
-    return SampleAllocation::from_counts(plan, std::move(tiles));
-  } catch (const std::exception&) {
-    return std::nullopt;
-  }
-}
-
-void write_allocation(const fs::path& path, const SampleAllocation& a) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << allocation_json(a).dump();
-    out.flush();
-    if (!out) throw StorageError("cannot write " + tmp.string());
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) throw StorageError("cannot write " + path.string() + ": " + ec.message());
-}
-
-}  // namespace
 
 bool JobService::Impl::allocate(Job& job) {
   const fs::path path = job.dir / kAllocationFile;
@@ -818,6 +856,7 @@ std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_compl
            {"estimated_relative_rms_rgb", rms_rgb ? nlohmann::json{{"r", rms_rgb->r}, {"g", rms_rgb->g}, {"b", rms_rgb->b}}
                                                   : nlohmann::json(nullptr)},
            {"pixels_without_estimate", sums.unknown}});
+      write_report(job);
       const auto& q = job.request.quality;
       if (job.merger->complete()) {
         stop = "samples";

@@ -229,10 +229,19 @@ TEST(JobService, RestartResumesFromMergedPassesWithIdenticalBytes) {
   run_shuffled(restarted, rng, 5);
   EXPECT_EQ((*restarted.status(id))["state"], "done");
   EXPECT_EQ(read_file(*&restarted.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local"));
-  // And a done job stays downloadable after another restart.
+  // And a done job stays downloadable after another restart, with the same
+  // report: what stopped it, its run time and its error history.
+  const auto before = *restarted.status(id);
   JobService again(dir);
-  EXPECT_EQ((*again.status(id))["state"], "done");
+  const auto after = *again.status(id);
+  EXPECT_EQ(after["state"], "done");
   EXPECT_TRUE(fs::exists(again.image(id, ImageFormat::kPng)->path));
+  EXPECT_EQ(after["stopped_by"], "samples");
+  EXPECT_EQ(after["error"]["history"], before["error"]["history"]);
+  EXPECT_EQ(after["error"]["estimated_relative_rms"], before["error"]["estimated_relative_rms"]);
+  EXPECT_GE(before["error"]["history"].size(), 2u) << "an entry per observed pass: " << before["error"]["history"].dump();
+  EXPECT_NEAR(after["elapsed_s"].get<double>(), before["elapsed_s"].get<double>(), 1e-6);
+  EXPECT_GT(after["elapsed_s"].get<double>(), 0.0);
 }
 
 TEST(JobService, PreviewAfterFirstPassWithChangingEtag) {
@@ -495,11 +504,17 @@ TEST(JobService, AdaptiveJobResumesWithItsStoredAllocation) {
     }
   }
   JobService restarted(dir);
-  EXPECT_TRUE((*restarted.status(id))["plan"].contains("samples_per_pass_after_pilot"));
+  const auto resumed = *restarted.status(id);
+  EXPECT_TRUE(resumed["plan"].contains("samples_per_pass_after_pilot"));
+  EXPECT_EQ(resumed["error"]["history"].size(), 1u) << "the pilot's entry survives the restart";
   std::mt19937 rng(10);
   run_shuffled(restarted, rng, 3);
-  ASSERT_EQ((*restarted.status(id))["state"], "done");
+  const auto done = *restarted.status(id);
+  ASSERT_EQ(done["state"], "done");
+  EXPECT_EQ(done["error"]["history"].size(), 3u);
   EXPECT_EQ(read_file(restarted.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kAdaptive));
+  EXPECT_EQ((*JobService(dir).status(id))["progress"]["samples_per_pixel"], done["progress"]["samples_per_pixel"])
+      << "a done adaptive job's mean samples per pixel, after another restart";
   // Without its allocation the job cannot tell its pilot from later passes: it fails, saying why.
   const std::string lost_id = [&] {
     JobService service(dir / "lost");
