@@ -17,6 +17,7 @@
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
 #include "common/render/render_plan.h"
+#include "common/render/render_progress.h"
 #include "common/render/sample_allocation.h"
 #include "common/render/sun_pixels.h"
 #include "common/sampling/sampler.h"
@@ -171,6 +172,17 @@ struct Job {
     if (!requeued.empty()) return true;
     return cursor < static_cast<std::size_t>(plan.unit_count()) &&
            !(waits_for_allocation() && unit_at(plan, cursor).pass > 0);
+  }
+  // Towards the first of the request's limits (render_progress.h): 1 when done.
+  double progress() const {
+    if (record.state == "done") return 1.0;
+    const std::int64_t total = merger->total_units();
+    const double samples_share = total > 0 ? static_cast<double>(merger->merged_units()) / total : 1.0;
+    std::optional<double> estimate;
+    if (!history.empty() && history.back()["estimated_relative_rms"].is_number())
+      estimate = history.back()["estimated_relative_rms"].get<double>();
+    return render_progress(samples_share, elapsed_s(), request.quality.time_limit_s,
+                           request.quality.target_relative_error, estimate);
   }
   // Run time, including what the job ran before a restart (report.json).
   double elapsed_before_s = 0.0;
@@ -449,8 +461,8 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
 }
 
 nlohmann::json JobService::Impl::status_of(const Job& job) const {
-  const int merged = job.merger->merged_units(), total = job.merger->total_units();
-  const double fraction = job.record.state == "done" ? 1.0 : total > 0 ? static_cast<double>(merged) / total : 1.0;
+  const std::int64_t merged = job.merger->merged_units(), total = job.merger->total_units();
+  const double fraction = job.progress();
   const double elapsed = job.elapsed_s();
   const int passes = job.merger->complete_passes();
   const nlohmann::json spp = job.samples_per_pixel(passes);
@@ -459,7 +471,8 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
     plan["samples_per_pass_after_pilot"] = {{"min", job.allocation->min_samples_per_pass()},
                                             {"max", job.allocation->max_samples_per_pass()}};
   nlohmann::json eta = nullptr;
-  if (job.active() && fraction > 0.0) eta = elapsed * (1.0 - fraction) / fraction;
+  if (job.active())
+    if (const auto left = remaining_seconds(fraction, elapsed)) eta = *left;
   nlohmann::json workers_json = nlohmann::json::array();
   for (const auto& [id, n] : job.worker_units) workers_json.push_back({{"id", id}, {"units", n}});
   const std::string self = "/v1/renders/" + job.record.id;
@@ -1010,10 +1023,7 @@ std::optional<JobSummary> JobService::summary(const std::string& id) const {
   const Job& job = *it->second;
   JobSummary s;
   s.state = job.record.state;
-  const int total = job.merger->total_units();
-  s.fraction = job.record.state == "done" ? 1.0
-               : total > 0               ? static_cast<double>(job.merger->merged_units()) / total
-                                         : 1.0;
+  s.fraction = job.progress();
   if (!job.history.empty() && job.history.back()["estimated_relative_rms"].is_number())
     s.estimated_relative_rms = job.history.back()["estimated_relative_rms"].get<double>();
   s.failure = job.record.failure;

@@ -93,7 +93,7 @@ struct JobEvent {
 // follows many frames).
 struct JobSummary {
   std::string state;
-  double fraction = 0.0;                          // units merged / units total (1 when done)
+  double fraction = 0.0;                          // progress towards the first limit (render_progress.h; 1 when done)
   std::optional<double> estimated_relative_rms;   // after the first complete pass
   std::string failure;                            // when failed
 };

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -28,13 +29,13 @@ bool read_input(const std::string& path, std::string* text, std::string* error) 
 ProgressDisplay::ProgressDisplay(std::string label)
     : label_(std::move(label)), tty_(isatty(STDERR_FILENO) != 0), start_(std::chrono::steady_clock::now()) {}
 
-void ProgressDisplay::update(int done, int total) {
+void ProgressDisplay::update(double fraction) {
   const auto now = std::chrono::steady_clock::now();
   const double elapsed = std::chrono::duration<double>(now - start_).count();
-  const double fraction = total > 0 ? static_cast<double>(done) / total : 1.0;
+  fraction = std::clamp(fraction, 0.0, 1.0);
   const double eta = fraction > 0.0 ? elapsed * (1.0 - fraction) / fraction : 0.0;
   if (tty_) {
-    if (done < total && now - last_draw_ < std::chrono::milliseconds(100)) return;
+    if (fraction < 1.0 && now - last_draw_ < std::chrono::milliseconds(100)) return;
     last_draw_ = now;
     constexpr int kWidth = 40;
     const int filled = static_cast<int>(fraction * kWidth);
@@ -47,8 +48,7 @@ void ProgressDisplay::update(int done, int total) {
   const int decile = static_cast<int>(fraction * 10.0);
   if (decile == last_decile_) return;
   last_decile_ = decile;
-  std::fprintf(stderr, "%s: %3d%% (%d/%d units, %.1f s elapsed, eta %.1f s)\n", label_.c_str(), decile * 10, done,
-               total, elapsed, eta);
+  std::fprintf(stderr, "%s: %3d%% (%.1f s elapsed, eta %.1f s)\n", label_.c_str(), decile * 10, elapsed, eta);
 }
 
 void ProgressDisplay::finish() {

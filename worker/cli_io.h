@@ -13,8 +13,9 @@ bool read_input(const std::string& path, std::string* text, std::string* error);
 class ProgressDisplay {
  public:
   explicit ProgressDisplay(std::string label);
-  // done of total units; redraws at most every 100 ms on a terminal, every 10 % otherwise.
-  void update(int done, int total);
+  // Progress in [0, 1] (render_progress.h); redraws at most every 100 ms on
+  // a terminal, every 10 % otherwise.
+  void update(double fraction);
   void finish();
 
  private:

@@ -81,7 +81,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
                label.c_str(), plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
                scene.sun().zenith_deg(), scene.sun().azimuth_deg());
   ProgressDisplay progress(label);
-  const auto on_progress = [&](int done, int total) { progress.update(done, total); };
+  const auto on_progress = [&](double fraction) { progress.update(fraction); };
   LocalRenderResult result;
   double samples = plan.samples_per_pixel;
   std::string stopped_by = "samples";

@@ -8,8 +8,15 @@
 #include "common/film/error_estimate.h"
 #include "common/film/mirror_image.h"
 #include "common/render/parallel.h"
+#include "common/render/render_progress.h"
 
 namespace skyfarm {
+
+namespace {
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
 
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,
                                const RenderProgress& progress) {
@@ -31,7 +38,7 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
     image->resolve(film);  // disjoint pixels per tile
     if (progress) {
       const std::lock_guard<std::mutex> lock(mutex);
-      progress(++done, tiles);
+      progress(static_cast<double>(++done) / tiles);
     }
   });
   if (plan.mirrored) mirror_left_half(image);
@@ -58,7 +65,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
   std::vector<PathCounters> counters(static_cast<std::size_t>(tiles));
   ProgressiveResult r;
   r.stopped_by = "samples";
-  int done = 0;
+  std::int64_t done = 0;  // units (tile passes): 131072 x 65536 for the largest open-ended frame
   std::mutex mutex;
   for (int p = 0; p < plan.passes; ++p) {
     parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
@@ -70,7 +77,10 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       film[t].merge(pass);
       if (progress) {
         const std::lock_guard<std::mutex> lock(mutex);
-        progress(++done, tiles * plan.passes);
+        const double samples_share =
+            static_cast<double>(++done) / (static_cast<double>(tiles) * static_cast<double>(plan.passes));
+        progress(render_progress(samples_share, seconds_since(t0), stop.time_limit_s, stop.target_relative_error,
+                                 r.estimate));
       }
     });
     r.passes = p + 1;

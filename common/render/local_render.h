@@ -18,8 +18,9 @@
 
 namespace skyfarm {
 
-// Called after each finished tile with (tiles done, tiles total); from worker threads, serialised.
-using RenderProgress = std::function<void(int done, int total)>;
+// Called after each finished tile with the render's progress in [0, 1]
+// (render_progress.h: towards the first of its limits); from worker threads, serialised.
+using RenderProgress = std::function<void(double progress)>;
 
 struct LocalRenderResult {
   PathCounters counters;

@@ -549,6 +549,19 @@ TEST(JobService, OpenEndedRendersFitTheQueueAndAnOversizedOneIsRefusedByName) {
   const auto s = *service.status(open_ended.id);
   EXPECT_EQ(s["plan"]["passes"], 65536);
   EXPECT_EQ(s["progress"]["units_total"].get<std::int64_t>(), 64LL * 65536);
+  // Its progress is towards the target and the time limit, not the 65536 passes: a first pass
+  // at an estimate of e is (0.01 / e)^2 of the way, t seconds t / 120 of it.
+  std::vector<UnitAssignment> pilot;
+  for (int i = 0; i < 64; ++i) pilot.push_back(*service.next_unit("w"));
+  for (const auto& a : pilot) service.unit_done("w", a.key, a.attempt, render_assignment(a), 1);
+  const auto after_pass = *service.status(open_ended.id);
+  const double e = after_pass["error"]["estimated_relative_rms"].get<double>();
+  const double elapsed = after_pass["elapsed_s"].get<double>();
+  EXPECT_NEAR(after_pass["progress"]["fraction"].get<double>(),
+              std::max({0.0001 / (e * e), elapsed / 120.0, 64.0 / (64.0 * 65536)}), 1e-3);
+  EXPECT_GT(after_pass["progress"]["fraction"].get<double>(), 0.001) << after_pass["progress"];
+  EXPECT_LT(after_pass["eta_s"].get<double>(), 3600.0) << "not the 65536 passes' eta";
+  service.cancel(open_ended.id);
   // 1024 units waiting (16 passes of 64 tiles) and 128 more fit under 5000.
   EXPECT_TRUE(service.submit(api::parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 10},
       "camera": {"projection": "equirectangular", "width": 256, "height": 128}})"), std::nullopt).created);
