@@ -77,8 +77,10 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
     layers.spectral = SpectralLayout{plan.lambda_min_nm, plan.lambda_max_nm, plan.batches};
   layers.relative_error = request.output.error_layer;
   Image image(plan.width, plan.height, layers);
-  std::fprintf(stderr, "%s: %dx%d, %d spp, %d batches, %d tiles, sun at zenith %.3f deg azimuth %.3f deg\n",
-               label.c_str(), plan.width, plan.height, plan.samples_per_pixel, plan.batches, plan.tile_count(),
+  const bool open_ended = request.quality.target_relative_error || request.quality.time_limit_s;
+  std::fprintf(stderr, "%s: %dx%d, %s%d spp%s, %d batches, %d tiles, sun at zenith %.3f deg azimuth %.3f deg\n",
+               label.c_str(), plan.width, plan.height, open_ended ? "up to " : "", plan.samples_per_pixel,
+               plan.adaptive ? " (mean, adaptive)" : "", plan.batches, plan.tile_count(),
                scene.sun().zenith_deg(), scene.sun().azimuth_deg());
   ProgressDisplay progress(label);
   const auto on_progress = [&](double fraction) { progress.update(fraction); };
