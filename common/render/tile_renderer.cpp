@@ -1,6 +1,7 @@
 #include "common/render/tile_renderer.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <vector>
 
 #include "common/lut/lut_sky.h"
@@ -120,6 +121,9 @@ void TileRenderer::render_unit(const WorkUnit& unit, FilmTile* film, PathCounter
 }
 
 FilmTile TileRenderer::render_tile(int tile, PathCounters* counters) const {
+  if (plan_.adaptive)
+    throw std::logic_error("render_tile: an adaptive plan's passes after the pilot need the whole frame's pilot "
+                           "(render_image_progressive)");
   FilmTile total = empty_tile(tile);
   for (int p = 0; p < plan_.passes; ++p) {
     FilmTile pass = empty_tile(tile);

@@ -33,8 +33,9 @@ class TileRenderer {
   FilmTile empty_tile(int tile) const;
   // Adds the samples of one unit to `film` (which must be tile unit.tile).
   void render_unit(const WorkUnit& unit, FilmTile* film, PathCounters* counters) const;
-  // All passes and batches of a tile, merged in canonical order (uniform
-  // plans: an adaptive plan's later passes need every tile's pilot first).
+  // All passes and batches of a tile, merged in canonical order.  Uniform
+  // plans only (std::logic_error otherwise): an adaptive plan's later passes
+  // need every tile's pilot first.
   FilmTile render_tile(int tile, PathCounters* counters) const;
 
   const RenderPlan& plan() const { return plan_; }
