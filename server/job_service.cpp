@@ -146,6 +146,10 @@ struct Job {
   // dir/allocation.json; until then no unit of a later pass is handed out.
   std::optional<SampleAllocation> allocation;
   bool waits_for_allocation() const { return plan.adaptive && !allocation; }
+  // Each tile's pilot statistics, taken as its pilot completes (while the
+  // tile is in memory), so that the allocation does not read every tile back
+  // from disk under the service's lock; empty entries are read at allocation.
+  std::vector<std::optional<SampleAllocation::BlockStatistics>> pilot_statistics;
   // Mean samples per pixel after `passes` whole passes (the EXR's metadata,
   // as a local render writes it), and as the status shows it.
   double mean_samples_per_pixel(int passes) const {
@@ -818,10 +822,17 @@ bool JobService::Impl::allocate(Job& job) {
                   "pass can no longer be told apart from later passes");
     return false;
   }
+  // The statistics taken as the pilots completed; a tile without them (a
+  // restart in between) is read back.
   std::vector<SampleAllocation::BlockStatistics> rms(static_cast<std::size_t>(job.plan.tile_count()));
-  job.merger->visit_tiles([&](int t, const FilmTile& tile) {
-    rms[static_cast<std::size_t>(t)] = SampleAllocation::pilot_statistics(job.plan, t, tile, job.sun_pixels);
-  });
+  job.pilot_statistics.resize(rms.size());
+  for (std::size_t t = 0; t < rms.size(); ++t)
+    rms[t] = job.pilot_statistics[t] ? std::move(*job.pilot_statistics[t])
+                                     : SampleAllocation::pilot_statistics(job.plan, static_cast<int>(t),
+                                                                          job.merger->sums_of(static_cast<int>(t)),
+                                                                          job.sun_pixels);
+  job.pilot_statistics.clear();
+  job.pilot_statistics.shrink_to_fit();
   SampleAllocation a = SampleAllocation::from_statistics(job.plan, rms);
   try {
     write_allocation(path, a);
@@ -935,6 +946,11 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
   try {
     FilmTile film = FilmTile::deserialize(bytes);
     if (job.merger->add(f.unit, std::move(film))) {
+      if (job.waits_for_allocation() && job.merger->merged_units_of(f.unit.tile) == job.plan.batches) {
+        job.pilot_statistics.resize(static_cast<std::size_t>(job.plan.tile_count()));
+        job.pilot_statistics[static_cast<std::size_t>(f.unit.tile)] = SampleAllocation::pilot_statistics(
+            job.plan, f.unit.tile, job.merger->sums_of(f.unit.tile), job.sun_pixels);
+      }
       ++job.worker_units[worker_id];
       job.paths += paths;
       impl_->recent_paths.emplace_back(Clock::now(), paths);

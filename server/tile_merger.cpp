@@ -175,10 +175,6 @@ void TileMerger::load() {
   }
 }
 
-void TileMerger::visit_tiles(const std::function<void(int, const FilmTile&)>& fn) const {
-  for (int t = 0; t < plan_.tile_count(); ++t) fn(t, tile(t));
-}
-
 FilmTile& TileMerger::tile(int t) const {
   auto& slot = cache_[static_cast<std::size_t>(t)];
   if (slot) {

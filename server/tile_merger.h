@@ -16,7 +16,6 @@
 // film in the server's memory.
 #pragma once
 #include <filesystem>
-#include <functional>
 #include <list>
 #include <map>
 #include <memory>
@@ -65,8 +64,9 @@ class TileMerger {
 
   // Resolves every tile into `image` (sizes must match).
   void resolve(Image* image) const;
-  // Calls fn(t, sums) for every tile in order, one tile in memory at a time.
-  void visit_tiles(const std::function<void(int, const FilmTile&)>& fn) const;
+  // Units merged into tile t, and its sums (read back from disk if needed).
+  int merged_units_of(int t) const { return next_index_[static_cast<std::size_t>(t)]; }
+  const FilmTile& sums_of(int t) const { return tile(t); }
   // ErrorSums::relative_rms: sqrt(sum_i var(Y_i) / sum_i Y_i^2) with the true
   // sum Y^2 estimated from the noisy means, over pixels with an estimate, or
   // nullopt; `excluded` are the sun disk's pixels (render/sun_pixels.h).

@@ -515,6 +515,25 @@ TEST(JobService, AdaptiveJobResumesWithItsStoredAllocation) {
   EXPECT_EQ(read_file(restarted.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kAdaptive));
   EXPECT_EQ((*JobService(dir).status(id))["progress"]["samples_per_pixel"], done["progress"]["samples_per_pixel"])
       << "a done adaptive job's mean samples per pixel, after another restart";
+  // A restart in the middle of the pilot: the tiles merged before it are read
+  // back for their statistics, and the bytes are still the local render's.
+  {
+    const fs::path mid = dir / "mid_pilot";
+    std::string mid_id;
+    {
+      JobService service(mid);
+      mid_id = service.submit(api::parse_render_request(kAdaptive), std::nullopt).id;
+      for (int i = 0; i < 5; ++i) {
+        const auto a = service.next_unit("w");
+        service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+      }
+    }
+    JobService resumed(mid);
+    std::mt19937 rng2(11);
+    run_shuffled(resumed, rng2, 3);
+    ASSERT_EQ((*resumed.status(mid_id))["state"], "done");
+    EXPECT_EQ(read_file(resumed.image(mid_id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kAdaptive));
+  }
   // Without its allocation the job cannot tell its pilot from later passes: it fails, saying why.
   const std::string lost_id = [&] {
     JobService service(dir / "lost");
