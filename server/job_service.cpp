@@ -188,6 +188,7 @@ struct Job {
     return render_progress(samples_share, elapsed_s(), request.quality.time_limit_s,
                            request.quality.target_relative_error, estimate);
   }
+  Clock::time_point report_written{};  // write_report's last write
   // Run time, including what the job ran before a restart (report.json).
   double elapsed_before_s = 0.0;
   double elapsed_s() const {
@@ -219,14 +220,31 @@ bool write_atomically(const fs::path& path, const std::string& text) {
 
 // What the status reports beyond the merged tiles, kept in the job's
 // directory so that a restart does not lose it: the error history, what
-// stopped the job, and its run time so far.  Best effort: a job whose report
-// cannot be written still renders (its tiles are the data).
-void write_report(const Job& job) {
+// stopped the job, and its run time so far.  Written at every state change
+// and every recorded pass, but beyond the first 64 passes at most once a
+// second (a small frame's passes can take milliseconds).  Best effort: a job
+// whose report cannot be written still renders (its tiles are the data).
+void write_report(Job& job, bool state_change) {
+  const Clock::time_point now = Clock::now();
+  if (!state_change && job.history.size() > 64 && now - job.report_written < std::chrono::seconds(1)) return;
+  job.report_written = now;
   if (!fs::exists(job.dir)) return;
   const nlohmann::json report = {{"history", job.history},
                                  {"stopped_by", job.stopped_by},
                                  {"elapsed_s", job.elapsed_s()}};
   write_atomically(job.dir / kReportFile, report.dump());
+}
+
+// At most kMaxHistory entries: beyond that every second entry but the last
+// goes, so a long job's history keeps its whole span at a coarser step (a
+// 1x1 frame to a tight target error can run a pass per millisecond).
+constexpr std::size_t kMaxHistory = 512;
+void thin_history(nlohmann::json* history) {
+  if (history->size() <= kMaxHistory) return;
+  nlohmann::json kept = nlohmann::json::array();
+  for (std::size_t i = 0; i + 1 < history->size(); i += 2) kept.push_back(std::move((*history)[i]));
+  kept.push_back(std::move(history->back()));
+  *history = std::move(kept);
 }
 
 void read_report(Job& job) {
@@ -391,7 +409,7 @@ void JobService::Impl::set_state(Job& job, const std::string& state, const std::
   job.record.state = state;
   job.record.failure = failure;
   if (is_terminal(state)) job.end_time = Clock::now();
-  write_report(job);
+  write_report(job, true);
   if (state_observer) state_observer(job.record.id, state);
 }
 
@@ -880,7 +898,8 @@ std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_compl
            {"estimated_relative_rms_rgb", rms_rgb ? nlohmann::json{{"r", rms_rgb->r}, {"g", rms_rgb->g}, {"b", rms_rgb->b}}
                                                   : nlohmann::json(nullptr)},
            {"pixels_without_estimate", sums.unknown}});
-      write_report(job);
+      thin_history(&job.history);
+      write_report(job, false);
       const auto& q = job.request.quality;
       if (job.merger->complete()) {
         stop = "samples";

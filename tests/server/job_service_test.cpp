@@ -14,6 +14,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <memory>
 #include <random>
 #include <unistd.h>
 
@@ -45,11 +46,25 @@ std::string read_file(const fs::path& p) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-// A simulated worker: renders an assignment exactly as a farm worker does.
+// A simulated worker: renders an assignment exactly as a farm worker does,
+// with its setup cached per request (as a farm worker caches it per job).
+struct CachedSetup {
+  api::RenderSetup setup;
+  std::unique_ptr<TileRenderer> renderer;
+};
+const TileRenderer& renderer_for(const std::string& request_canonical) {
+  static std::map<std::string, std::unique_ptr<CachedSetup>> cache;
+  auto& entry = cache[request_canonical];
+  if (!entry) {
+    entry = std::make_unique<CachedSetup>();
+    entry->setup = api::make_render_setup(api::parse_render_request(request_canonical));
+    entry->renderer = std::make_unique<TileRenderer>(*entry->setup.scene, *entry->setup.camera, entry->setup.plan);
+  }
+  return *entry->renderer;
+}
+
 std::vector<std::uint8_t> render_assignment(const UnitAssignment& a) {
-  const api::RenderRequest request = api::parse_render_request(a.request_canonical);
-  const api::RenderSetup setup = api::make_render_setup(request);
-  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  const TileRenderer& renderer = renderer_for(a.request_canonical);
   FilmTile film = renderer.empty_tile(a.key.tile);
   PathCounters counters;
   WorkUnit unit{a.key.tile, a.key.batch, a.key.pass, {}};
@@ -595,6 +610,27 @@ TEST(JobService, OpenEndedRendersFitTheQueueAndAnOversizedOneIsRefusedByName) {
   } catch (const CapacityExceeded& e) {
     EXPECT_NE(std::string(e.what()).find("this render alone"), std::string::npos) << e.what();
   }
+}
+
+// A long job's history keeps its whole span in at most 512 entries: a 1x1
+// frame of 700 passes (a pass takes well under a millisecond).
+TEST(JobService, ALongJobsHistoryIsThinnedNotTruncated) {
+  const fs::path dir = fresh_dir("history");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(R"({"sun": {"zenith_deg": 40, "azimuth_deg": 10},
+    "camera": {"projection": "perspective", "width": 1, "height": 1, "pitch_deg": 30},
+    "quality": {"samples_per_pixel": 11200}, "seed": 2})"), std::nullopt).id;
+  while (const auto a = service.next_unit("w")) service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+  const auto s = *service.status(id);
+  ASSERT_EQ(s["state"], "done");
+  const auto& h = s["error"]["history"];
+  EXPECT_LE(h.size(), 512u);
+  EXPECT_GT(h.size(), 256u);
+  EXPECT_EQ(h.front()["samples_per_pixel"], 16);
+  EXPECT_EQ(h.back()["samples_per_pixel"], 11200);
+  for (std::size_t i = 1; i < h.size(); ++i)
+    EXPECT_LT(h[i - 1]["samples_per_pixel"].get<int>(), h[i]["samples_per_pixel"].get<int>()) << i;
+  EXPECT_EQ((*JobService(dir).status(id))["error"]["history"], h) << "the report holds the same history";
 }
 
 }  // namespace
