@@ -14,6 +14,7 @@
 #include "api/render_setup.h"
 #include "common/atmosphere/atmosphere_builder.h"
 #include "common/film/film_tile.h"
+#include "common/image/atomic_file.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
 #include "common/render/render_plan.h"
@@ -203,19 +204,17 @@ namespace {
 const char* kAllocationFile = "allocation.json";
 const char* kReportFile = "report.json";
 
-// Writes `text` to `path` through a temporary file and a rename (readers and
-// a crash see the old or the new file, never half of one).
-bool write_atomically(const fs::path& path, const std::string& text) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::trunc);
-    out << text;
-    out.flush();
-    if (!out) return false;
+// Writes `text` to `path` atomically (image/atomic_file.h): readers see the
+// old or the new file, never half of one; kSynced survives a power failure.
+bool write_atomically(const fs::path& path, const std::string& text, AtomicFile::Durability durability) {
+  try {
+    AtomicFile file(path);
+    file.write(text.data(), text.size());
+    file.commit(durability);
+    return true;
+  } catch (const FileWriteError&) {
+    return false;
   }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  return !ec;
 }
 
 // What the status reports beyond the merged tiles, kept in the job's
@@ -232,7 +231,9 @@ void write_report(Job& job, bool state_change) {
   const nlohmann::json report = {{"history", job.history},
                                  {"stopped_by", job.stopped_by},
                                  {"elapsed_s", job.elapsed_s()}};
-  write_atomically(job.dir / kReportFile, report.dump());
+  // Not synced: after a power failure the last second of history may be gone
+  // (an unreadable report is ignored), the tiles are still the data.
+  write_atomically(job.dir / kReportFile, report.dump(), AtomicFile::Durability::kRenamed);
 }
 
 // At most kMaxHistory entries: beyond that every second entry but the last
@@ -288,7 +289,10 @@ std::optional<SampleAllocation> read_allocation(const fs::path& path, const Rend
 }
 
 void write_allocation(const fs::path& path, const SampleAllocation& a) {
-  if (!write_atomically(path, allocation_json(a).dump())) throw StorageError("cannot write " + path.string());
+  // Synced: the passes after the pilot are rendered with these counts, so
+  // losing the file would lose the job (JobService::Impl::allocate).
+  if (!write_atomically(path, allocation_json(a).dump(), AtomicFile::Durability::kSynced))
+    throw StorageError("cannot write " + path.string());
 }
 
 }  // namespace
