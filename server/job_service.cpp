@@ -154,12 +154,11 @@ struct Job {
   // Mean samples per pixel after `passes` whole passes (the EXR's metadata,
   // as a local render writes it), and as the status shows it.
   double mean_samples_per_pixel(int passes) const {
-    if (allocation) return allocation->mean_samples_per_pixel(plan, passes);
-    return std::min(plan.samples_per_pixel, passes * plan.samples_per_pass);
+    return allocation ? allocation->mean_samples_per_pixel(plan, passes) : plan.samples_after(passes);
   }
   nlohmann::json samples_per_pixel(int passes) const {
     if (allocation) return std::round(mean_samples_per_pixel(passes) * 10.0) / 10.0;
-    return std::min(plan.samples_per_pixel, passes * plan.samples_per_pass);
+    return plan.samples_after(passes);
   }
 
   std::size_t unit_index(const WorkUnit& u) const {

@@ -86,7 +86,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     r.passes = p + 1;
     if (p == 0 && plan.adaptive) r.allocation = SampleAllocation::from_pilot(plan, film, renderer.sun_pixels());
     r.samples_per_pixel = r.allocation ? r.allocation->mean_samples_per_pixel(plan, r.passes)
-                                       : std::min(plan.samples_per_pixel, r.passes * plan.samples_per_pass);
+                                       : plan.samples_after(r.passes);
     ErrorSums error;
     for (const auto& tile : film) error.add(error_sums(tile, renderer.sun_pixels(), plan.width));  // tile order
     r.estimate = error.relative_rms();

@@ -30,7 +30,7 @@ int RenderPlan::blocks_x(int tile) const {
 int RenderPlan::block_count(int tile) const {
   int x0 = 0, y0 = 0, w = 0, h = 0;
   tile_rect(tile, &x0, &y0, &w, &h);
-  return ((w + kAllocationBlock - 1) / kAllocationBlock) * ((h + kAllocationBlock - 1) / kAllocationBlock);
+  return blocks_x(tile) * ((h + kAllocationBlock - 1) / kAllocationBlock);
 }
 
 int RenderPlan::block_of(int tile, int x, int y) const {

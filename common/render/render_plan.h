@@ -18,6 +18,7 @@
 // and renders samples [S + (p - 1) n, S + p n) of each pixel (sample_range; a
 // short last pass in proportion).
 #pragma once
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -82,6 +83,8 @@ struct RenderPlan {
   // Samples [first, end) of pass p.
   int pass_first_sample(int pass) const { return pass * samples_per_pass; }
   int pass_end_sample(int pass) const;
+  // Samples per pixel after `passes` whole passes of a uniform plan.
+  int samples_after(int passes) const { return std::min(samples_per_pixel, passes * samples_per_pass); }
   // Allocation blocks of tile t (row-major, kAllocationBlock pixels square,
   // edge blocks smaller), and the block of pixel (x, y) of that tile.
   int blocks_x(int tile) const;
