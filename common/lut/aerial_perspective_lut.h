@@ -30,6 +30,7 @@
 #include <span>
 #include <vector>
 
+#include "common/core/huge_page_allocator.h"
 #include "common/lut/ground_irradiance_lut.h"
 #include "common/lut/medium_table.h"
 #include "common/lut/multiple_scattering_lut.h"
@@ -58,8 +59,8 @@ class AerialPerspectiveLut {
   double d_max_ = 0.0, R_top_ = 0.0;
   lut::ViewMapping mapping_;
   std::vector<double> end_;  // [row]: the distance of the last slice
-  std::vector<float> L_;     // [row][column][slice][bin], single precision (as the sky view)
-  std::vector<float> T_;     // [row][slice][bin]
+  TableVector<float> L_;     // [row][column][slice][bin], single precision (as the sky view)
+  TableVector<float> T_;     // [row][slice][bin]
 };
 
 }  // namespace skyfarm

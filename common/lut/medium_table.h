@@ -43,6 +43,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "common/core/huge_page_allocator.h"
 #include "common/atmosphere/atmosphere.h"
 #include "common/lut/spectral_grid.h"
 
@@ -102,7 +103,7 @@ class MediumTable {
   std::size_t memory_bytes() const;
 
  private:
-  static void interpolate(const std::vector<double>& table, Node n, int width, double* out) {
+  static void interpolate(const TableVector<double>& table, Node n, int width, double* out) {
     const double* a = table.data() + n.i * static_cast<std::size_t>(width);
     const double* b = a + width;
     for (int k = 0; k < width; ++k) out[k] = a[k] + n.f * (b[k] - a[k]);
@@ -113,11 +114,11 @@ class MediumTable {
 
   int bins_ = 0, scatterers_ = 0, altitude_samples_ = 0, phase_samples_ = 0, terms_ = 0, padded_terms_ = 0;
   double R_ = 0.0, R_top_ = 0.0, dh_ = 0.0, inv_dh_ = 0.0;
-  std::vector<double> sigma_t_, sigma_s_, sigma_s_c_;  // [node][bin], [node][c][bin]
+  TableVector<double> sigma_t_, sigma_s_, sigma_s_c_;  // [node][bin], [node][c][bin]
   std::vector<PhaseFunction> phase_functions_;         // [c][bin]
-  std::vector<double> phase_table_;                    // [x node][c][bin]
+  TableVector<double> phase_table_;                    // [x node][c][bin]
   std::vector<double> albedo_;                         // [bin]
-  std::vector<EightTerms> term_profiles_;              // [node][padded k / 8]
+  TableVector<EightTerms> term_profiles_;              // [node][padded k / 8]
   std::vector<double> term_spectra_;                   // [padded k][bin]
 };
 

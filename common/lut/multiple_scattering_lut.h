@@ -29,6 +29,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "common/core/huge_page_allocator.h"
 #include "common/lut/bilinear.h"
 #include "common/lut/medium_table.h"
 #include "common/lut/transmittance_lut.h"
@@ -83,7 +84,7 @@ class MultipleScatteringLut {
  private:
   int bins_ = 0, n_mu_s_ = 0, n_h_ = 0, clamped_ = 0;
   double top_altitude_ = 0.0;
-  std::vector<float> values_;  // [altitude node][mu_s node][bin], single precision (bilinear.h)
+  TableVector<float> values_;  // [altitude node][mu_s node][bin], single precision (bilinear.h)
 };
 
 }  // namespace skyfarm

@@ -182,8 +182,12 @@ void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu
     const std::size_t m = std::min(kViewTile, N - first);
     std::copy(phase + first * C * B, phase + (first + m) * C * B, phase_f_.begin());
     std::fill(L_f_.begin(), L_f_.begin() + static_cast<std::ptrdiff_t>(m * B), 0.0f);
+    // A step of zero length adds exactly 0 (its weights are 0): skipped.  All
+    // steps of a ray that starts on the ground and goes down are (the sky-
+    // view table's ground rows for an observer at 0 m: half its rows).
     for (int k = std::max(0, k0); k < std::min(k1, steps_); ++k)
-      add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase_f_.data(), L_f_.data());
+      if (dt_[static_cast<std::size_t>(k)] > 0.0)
+        add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase_f_.data(), L_f_.data());
     double* out = L + first * B;
     for (std::size_t j = 0; j < m * B; ++j) out[j] += L_f_[j];
   }

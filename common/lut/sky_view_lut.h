@@ -27,6 +27,7 @@
 #include <span>
 #include <vector>
 
+#include "common/core/huge_page_allocator.h"
 #include "common/lut/ground_irradiance_lut.h"
 #include "common/lut/medium_table.h"
 #include "common/lut/multiple_scattering_lut.h"
@@ -54,7 +55,7 @@ class SkyViewLut {
  private:
   int bins_ = 0;
   lut::ViewMapping mapping_;
-  std::vector<float> values_;  // [row][column][bin], single precision (2.7 MB instead of 5.3 at 32 bins)
+  TableVector<float> values_;  // [row][column][bin], single precision (2.7 MB instead of 5.3 at 32 bins)
 };
 
 }  // namespace skyfarm

@@ -41,6 +41,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "common/core/huge_page_allocator.h"
 #include "common/lut/bilinear.h"
 #include "common/lut/medium_table.h"
 #include "common/lut/vector_math.h"
@@ -129,7 +130,7 @@ class TransmittanceLut {
  private:
   int bins_ = 0, n_mu_ = 0, n_r_ = 0, steps_ = 0;
   double R_ = 0.0, R_top_ = 0.0, H_ = 0.0;
-  std::vector<float> values_;  // [x_r node][x_mu node][bin], single precision (bilinear.h)
+  TableVector<float> values_;  // [x_r node][x_mu node][bin], single precision (bilinear.h)
 };
 
 }  // namespace skyfarm
