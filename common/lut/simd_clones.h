@@ -3,7 +3,7 @@
 // doubles per instruction), AVX2 and the baseline (SSE2), and the loader
 // picks one per CPU (function multi-versioning, an ifunc).  Only inline
 // code is compiled into the clones, so hot loops call header-inline helpers
-// (lut::Bilinear, lut::sqrt_inline, TransmittanceLut::mu_position).
+// (lut::Bilinear, lut::exp_inline, TransmittanceLut::mu_position).
 //
 // All clones give the same bits: the loops are element-wise (GCC does not
 // reorder a floating-point sum without -ffast-math), and contraction to FMA

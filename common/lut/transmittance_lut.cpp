@@ -85,7 +85,7 @@ class OpticalDepthQuadrature {
     double *__restrict w0 = w0_.data(), *__restrict w1 = w1_.data();
     for (std::size_t k = 0; k < n; ++k) {
       const double s = a + d * u2[k];
-      const double h = lut::sqrt_inline(l2 + s * s) - R;
+      const double h = std::sqrt(l2 + s * s) - R;
       const double x = std::min(std::max(h * inv_dh, 0.0), top_node);  // MediumTable::locate
       const int i = std::min(static_cast<int>(x), last_cell);
       const double f = x - i, w = d * weight[k];

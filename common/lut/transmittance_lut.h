@@ -70,10 +70,10 @@ class TransmittanceLut {
   };
   RadiusCoord locate_r(double r) const;
   double mu_position(const RadiusCoord& rc, double mu) const {
-    const double d = -rc.r * mu + lut::sqrt_inline(rc.r2 * mu * mu + rc.top_c);  // distance to the top
+    const double d = -rc.r * mu + std::sqrt(rc.r2 * mu * mu + rc.top_c);  // distance to the top
     const double x = (d - rc.d_min) * rc.inv_range;
     const double x_mu = std::min(1.0, std::max(0.0, x));
-    const double u = (1.0 - lut::sqrt_inline(lut::sqrt_inline(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
+    const double u = (1.0 - std::sqrt(std::sqrt(1.0 - x_mu))) * (n_mu_ - 1);  // the warp v(x_mu)
     return x > 1.0 + 1e-12 ? -1.0 : u;
   }
   // The four nodes and weights around (rc, u >= 0), for fused loops.

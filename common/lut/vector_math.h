@@ -1,16 +1,16 @@
-// exp and sqrt written as plain arithmetic, so that the LUT builders' loops
-// that call them vectorise.
+// exp written as plain arithmetic, so that the LUT builders' loops that call
+// it vectorise.
 //
-// Why: GCC compiles std::sqrt and std::exp to calls that may set errno, and
-// a loop with such a call stays scalar unless the whole translation unit is
-// built with -fno-math-errno (GCC 12 ignores it as a function attribute or
-// pragma).  The tables' builders spend most of their time in loops over
-// march steps and spectral bins that need one or both (a step's radius,
-// a look-up's position, a segment's transmittance), so these two replace
-// the library calls there.  Both use + - * / and integer operations on the
-// bit patterns only (no FMA, no table), so a vectorised clone and the scalar
-// code give the same bits (simd_clones.h), and a table built twice is
-// bit-identical.
+// Why: GCC compiles std::exp to a call, and a loop with a call stays scalar.
+// The tables' builders spend much of their time in loops over march steps
+// and spectral bins that need a segment's transmittance, so exp_inline
+// replaces the library call there.  It uses + - * / and integer operations
+// on the bit patterns only (no FMA, no table), so a vectorised clone and the
+// scalar code give the same bits (simd_clones.h), and a table built twice is
+// bit-identical.  (Square roots need no such help: skyfarm_common is built
+// with -fno-math-errno, so std::sqrt is one IEEE instruction, correctly
+// rounded in every clone, and vectorises; an earlier sqrt_inline of Newton
+// steps was slower than it.)
 //
 //   exp_inline(x)   e^x, x clamped to [-746, 709]; relative error < 3e-16
 //                   for normal results (measured against std::exp in
@@ -21,14 +21,8 @@
 //                   trailing zero bits, so n ln2_hi is exact), e^r by its
 //                   Taylor series to r^13 (remainder < 2e-16 relative), and
 //                   2^n from bit patterns.
-//   sqrt_inline(x)  sqrt(max(x, 0)): within 1 ulp of std::sqrt for normal
-//                   x (same test), 0 for x <= 0, NaN for NaN; inaccurate
-//                   (but below 1.5e-154) for subnormal x.  The bit-pattern
-//                   estimate of 1/sqrt(x) (error < 3.5 %), three Newton
-//                   steps on 1/sqrt(x) (error < 4e-11), then one on sqrt(x)
-//                   itself, which squares the error.
-// Neither has a branch or a select: GCC sinks the work behind a select into
-// a conditional block, which it then does not vectorise.
+// It has no branch or select: GCC sinks the work behind a select into a
+// conditional block, which it then does not vectorise.
 #pragma once
 #include <algorithm>
 #include <bit>
@@ -67,18 +61,6 @@ inline double exp_inline(double x) {
   const double s1 = std::bit_cast<double>(static_cast<std::uint64_t>(k1 + 1023) << 52);
   const double s2 = std::bit_cast<double>(static_cast<std::uint64_t>(k2 + 1023) << 52);
   return (p * s1) * s2;
-}
-
-inline double sqrt_inline(double x) {
-  const double xc = std::max(x, 0.0);                                        // NaN passes through
-  const double xe = std::max(xc, std::numeric_limits<double>::min());  // for the estimate
-  double y = std::bit_cast<double>(0x5fe6eb50c7b537a9u - (std::bit_cast<std::uint64_t>(xe) >> 1));
-  const double half = 0.5 * xe;
-  y = y * (1.5 - half * y * y);  // error 1.8e-3
-  y = y * (1.5 - half * y * y);  // 4.6e-6
-  y = y * (1.5 - half * y * y);  // 3.2e-11, squared by the last step
-  const double s = xc * y;      // 0 for x <= 0
-  return s + 0.5 * y * (xc - s * s);
 }
 
 }  // namespace skyfarm::lut
