@@ -6,15 +6,18 @@
 // 4 KiB pages took 45 ms, of fresh 2 MiB pages 0.7 ms), so the LUT sky's
 // 14 MB of tables cost more in faults (~36 ms) than in arithmetic.
 //
-// Blocks of at least kHugePageThreshold bytes are mapped on their own
-// (mmap), start on a 2 MiB boundary and are madvise(MADV_HUGEPAGE)d, so
-// that with transparent huge pages in "madvise" or "always" mode the kernel
-// backs them with 2 MiB pages; with THP off they are ordinary pages and cost
-// what they did.  Only whole 2 MiB ranges inside the block become huge pages:
-// the block's tail stays in 4 KiB pages, so the resident memory is the
-// block's size, not rounded up.  Smaller blocks come from operator new.
-// Fresh mappings are zero-filled by the kernel; the containers still value-
-// initialise their elements as usual.
+// Blocks of at least kHugePageMinBytes (1 MiB) are mapped on their own
+// (mmap), start on a 2 MiB boundary, are rounded up to whole 2 MiB pages and
+// are madvise(MADV_HUGEPAGE)d, so that with transparent huge pages in
+// "madvise" or "always" mode the kernel backs them with 2 MiB pages (with
+// THP off they are ordinary pages and cost what they did).  The rounding
+// costs memory (a 4.2 MB table takes 6 MiB): mapped_bytes() says how much,
+// and the tables report it in their memory_bytes().  Blocks of
+// kOwnMappingMinBytes (256 KiB) up to 1 MiB are mapped on their own too,
+// pre-faulted in one call; smaller ones come from operator new (glibc would
+// otherwise mmap and unmap them, faulting every time).  Fresh mappings are
+// zero-filled by the kernel; the containers still value-initialise their
+// elements as usual.
 #pragma once
 #include <cstddef>
 #include <new>
@@ -22,9 +25,13 @@
 
 namespace skyfarm {
 
-inline constexpr std::size_t kHugePageThreshold = std::size_t{1} << 20;
+inline constexpr std::size_t kOwnMappingMinBytes = std::size_t{256} << 10;
+inline constexpr std::size_t kHugePageMinBytes = std::size_t{1} << 20;
 
-// Maps `bytes` (>= 1) on a 2 MiB boundary with the huge-page hint; throws
+// The bytes a block of `bytes` occupies (its mapping, for the blocks mapped on their own).
+std::size_t mapped_bytes(std::size_t bytes);
+
+// Maps a block of `bytes` (>= kOwnMappingMinBytes) as above; throws
 // std::bad_alloc when the kernel refuses.  huge_page_unmap takes the same size.
 void* huge_page_map(std::size_t bytes);
 void huge_page_unmap(void* p, std::size_t bytes) noexcept;
@@ -38,12 +45,12 @@ struct HugePageAllocator {
 
   T* allocate(std::size_t n) {
     const std::size_t bytes = n * sizeof(T);
-    if (bytes >= kHugePageThreshold) return static_cast<T*>(huge_page_map(bytes));
+    if (bytes >= kOwnMappingMinBytes) return static_cast<T*>(huge_page_map(bytes));
     return static_cast<T*>(::operator new(bytes, std::align_val_t{alignof(T) > 64 ? alignof(T) : 64}));
   }
   void deallocate(T* p, std::size_t n) noexcept {
     const std::size_t bytes = n * sizeof(T);
-    if (bytes >= kHugePageThreshold)
+    if (bytes >= kOwnMappingMinBytes)
       huge_page_unmap(p, bytes);
     else
       ::operator delete(p, std::align_val_t{alignof(T) > 64 ? alignof(T) : 64});
@@ -57,5 +64,11 @@ struct HugePageAllocator {
 // A table's storage: a std::vector whose large blocks get 2 MiB pages.
 template <class T>
 using TableVector = std::vector<T, HugePageAllocator<T>>;
+
+// What a table's storage occupies (its capacity's mapping).
+template <class T>
+std::size_t table_memory_bytes(const TableVector<T>& v) {
+  return v.capacity() == 0 ? 0 : mapped_bytes(v.capacity() * sizeof(T));
+}
 
 }  // namespace skyfarm

@@ -52,7 +52,7 @@ class AerialPerspectiveLut {
 
   double max_distance_m() const { return d_max_; }
   const lut::ViewMapping& mapping() const { return mapping_; }
-  std::size_t memory_bytes() const { return (L_.size() + T_.size()) * sizeof(float); }
+  std::size_t memory_bytes() const { return table_memory_bytes(L_) + table_memory_bytes(T_); }
 
  private:
   int bins_ = 0, slices_ = 0;

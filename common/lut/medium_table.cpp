@@ -204,9 +204,9 @@ void MediumTable::phase_exact(double nu, double* out) const {
 }
 
 std::size_t MediumTable::memory_bytes() const {
-  return sizeof(double) * (sigma_t_.size() + sigma_s_.size() + sigma_s_c_.size() + phase_table_.size() +
-                            albedo_.size() + 8 * term_profiles_.size() + term_spectra_.size()) +
-         sizeof(PhaseFunction) * phase_functions_.size();
+  return table_memory_bytes(sigma_t_) + table_memory_bytes(sigma_s_) + table_memory_bytes(sigma_s_c_) +
+         table_memory_bytes(phase_table_) + table_memory_bytes(term_profiles_) +
+         sizeof(double) * (albedo_.size() + term_spectra_.size()) + sizeof(PhaseFunction) * phase_functions_.size();
 }
 
 }  // namespace skyfarm

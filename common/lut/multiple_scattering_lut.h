@@ -79,7 +79,7 @@ class MultipleScatteringLut {
   }
 
   int clamped_nodes() const { return clamped_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
+  std::size_t memory_bytes() const { return table_memory_bytes(values_); }
 
  private:
   int bins_ = 0, n_mu_s_ = 0, n_h_ = 0, clamped_ = 0;

@@ -50,7 +50,7 @@ class SkyViewLut {
   void lookup(double mu, double cos_phi, double* out) const;
 
   const lut::ViewMapping& mapping() const { return mapping_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
+  std::size_t memory_bytes() const { return table_memory_bytes(values_); }
 
  private:
   int bins_ = 0;

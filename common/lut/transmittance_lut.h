@@ -125,7 +125,7 @@ class TransmittanceLut {
 
   int mu_samples() const { return n_mu_; }
   int r_samples() const { return n_r_; }
-  std::size_t memory_bytes() const { return values_.size() * sizeof(float); }
+  std::size_t memory_bytes() const { return table_memory_bytes(values_); }
 
  private:
   int bins_ = 0, n_mu_ = 0, n_r_ = 0, steps_ = 0;

@@ -33,11 +33,24 @@ TEST(HugePageAllocator, SmallBlocksComeFromTheHeapAlignedForVectors) {
   TableVector<double> small(100, 2.5);
   EXPECT_EQ(reinterpret_cast<std::uintptr_t>(small.data()) % 64u, 0u);
   EXPECT_EQ(small[99], 2.5);
-  // A block just below and just at the threshold round-trip through both paths.
-  TableVector<char> below(kHugePageThreshold - 1, 'a'), at(kHugePageThreshold, 'b');
-  EXPECT_EQ(below.back(), 'a');
-  EXPECT_EQ(at.back(), 'b');
-  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(at.data()) % kTwoMiB, 0u);
+  // Blocks just below and at each threshold round-trip through every path.
+  TableVector<char> heap(kOwnMappingMinBytes - 1, 'a'), own(kOwnMappingMinBytes, 'b'),
+      below_huge(kHugePageMinBytes - 1, 'c'), huge(kHugePageMinBytes, 'd');
+  EXPECT_EQ(heap.back(), 'a');
+  EXPECT_EQ(own.back(), 'b');
+  EXPECT_EQ(below_huge.back(), 'c');
+  EXPECT_EQ(huge.back(), 'd');
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(huge.data()) % kTwoMiB, 0u);
+}
+
+TEST(HugePageAllocator, MemoryIsCountedAsMapped) {
+  EXPECT_EQ(mapped_bytes(1000), 1000u);                                   // from the heap
+  EXPECT_EQ(mapped_bytes(kOwnMappingMinBytes + 1), kOwnMappingMinBytes + 4096);  // whole pages
+  EXPECT_EQ(mapped_bytes(kHugePageMinBytes), kTwoMiB);                    // whole huge pages
+  EXPECT_EQ(mapped_bytes((std::size_t{4} << 20) + 1), 3 * kTwoMiB);
+  TableVector<float> v(3u << 18);
+  EXPECT_EQ(table_memory_bytes(v), 2 * kTwoMiB);
+  EXPECT_EQ(table_memory_bytes(TableVector<float>{}), 0u);
 }
 
 }  // namespace
