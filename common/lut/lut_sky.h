@@ -60,14 +60,14 @@
 // directions (with an isotropic scatterer the LUT agrees to 1.2 %).
 //
 // Cost (tests/bench/lut_bench.cpp, one core of a shared 2-core AMD EPYC VM,
-// CPU time, medians of 5 in a quiet session, 8 / 16 / 32 bins): all tables
-// 36-48 / 42-44 / 55-56 ms (the transmittance and multiple-scattering
-// tables, which depend on the atmosphere only, are 55 % of it); the
-// sun-dependent tables alone (with_sun) 9.5-11 / 12-14 / 15-16 ms; one
-// radiance look-up 65 / 80-105 / 97 ns; memory 3.6 / 7.0 / 13.8 MB.  Where
-// the time goes and what bounds it: docs/physics.md "The LUT sky's build
-// time".  A timelapse or a cache of many suns should build once and call
-// with_sun.
+// CPU time, medians in quiet runs, 8 / 32 bins): all tables 26 / 36-40 ms
+// (86 ms at 32 bins before the tables moved to huge pages: page faults cost
+// ~11 us each on this VM); the sun-dependent tables alone (with_sun) 6 /
+// 9.5 ms for an observer on the ground; one radiance look-up 84 / 107-139
+// ns; memory 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).
+// Where the time goes and what bounds it: docs/physics.md "The LUT sky's
+// build time".  A timelapse or a cache of many suns should build once and
+// call with_sun.
 #pragma once
 #include <atomic>
 #include <cstddef>
