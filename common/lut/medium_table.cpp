@@ -145,9 +145,8 @@ void MediumTable::build_coefficients(const Atmosphere& atmosphere, const Spectra
   }
   scatterers_ = static_cast<int>(scatterer.size());
   const std::size_t C = scatterer.size();
-  sigma_t_.assign(H * B, 0.0);
-  sigma_s_.assign(H * B, 0.0);
-  sigma_s_c_.assign(H * C * B, 0.0);
+  const std::size_t W = node_width();
+  coefficients_.assign(H * W, 0.0);
   std::vector<double> s(N);
   for (std::size_t i = 0; i < H; ++i)
     for (std::size_t b = 0; b < B; ++b) {
@@ -158,9 +157,10 @@ void MediumTable::build_coefficients(const Atmosphere& atmosphere, const Spectra
         s_t += s[c] + a;
         s_s += s[c];
       }
-      sigma_t_[i * B + b] = s_t;
-      sigma_s_[i * B + b] = s_s;
-      for (std::size_t c = 0; c < C; ++c) sigma_s_c_[(i * C + c) * B + b] = s[scatterer[c]];
+      double* node = coefficients_.data() + i * W;
+      node[b] = s_t;
+      node[B + b] = s_s;
+      for (std::size_t c = 0; c < C; ++c) node[(2 + c) * B + b] = s[scatterer[c]];
     }
 
   const Terms terms = extinction_terms(density, k_s, k_a, bracket, B);
@@ -196,7 +196,8 @@ void MediumTable::phase(double nu, double* out) const {
   const double x = std::sqrt(std::clamp(0.5 * (1.0 - nu), 0.0, 1.0));
   const double u = x * (phase_samples_ - 1);
   const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(phase_samples_ - 2));
-  interpolate(phase_table_, Node{i, u - static_cast<double>(i)}, scatterers_ * bins_, out);
+  interpolate(phase_table_.data(), static_cast<std::size_t>(scatterers_ * bins_), Node{i, u - static_cast<double>(i)},
+              scatterers_ * bins_, out);
 }
 
 void MediumTable::phase_exact(double nu, double* out) const {
@@ -204,8 +205,7 @@ void MediumTable::phase_exact(double nu, double* out) const {
 }
 
 std::size_t MediumTable::memory_bytes() const {
-  return table_memory_bytes(sigma_t_) + table_memory_bytes(sigma_s_) + table_memory_bytes(sigma_s_c_) +
-         table_memory_bytes(phase_table_) + table_memory_bytes(term_profiles_) +
+  return table_memory_bytes(coefficients_) + table_memory_bytes(phase_table_) + table_memory_bytes(term_profiles_) +
          sizeof(double) * (albedo_.size() + term_spectra_.size()) + sizeof(PhaseFunction) * phase_functions_.size();
 }
 

@@ -75,10 +75,14 @@ class MediumTable {
   double altitude_step_m() const { return dh_; }
 
   // Interpolated coefficients at a located altitude, out[b] for b < bins.
-  void sigma_t(Node n, double* out) const { interpolate(sigma_t_, n, bins_, out); }
-  void sigma_s(Node n, double* out) const { interpolate(sigma_s_, n, bins_, out); }
+  void sigma_t(Node n, double* out) const { interpolate(coefficients_.data(), node_width(), n, bins_, out); }
+  void sigma_s(Node n, double* out) const {
+    interpolate(coefficients_.data() + bins_, node_width(), n, bins_, out);
+  }
   // All scatterers at once: out[c * bins + b].
-  void sigma_s_per_scatterer(Node n, double* out) const { interpolate(sigma_s_c_, n, scatterers_ * bins_, out); }
+  void sigma_s_per_scatterer(Node n, double* out) const {
+    interpolate(coefficients_.data() + 2 * bins_, node_width(), n, scatterers_ * bins_, out);
+  }
 
   // p_c,b(nu) for all scatterers and bins, out[c * bins + b], from the table.
   void phase(double nu, double* out) const;
@@ -103,18 +107,24 @@ class MediumTable {
   std::size_t memory_bytes() const;
 
  private:
-  static void interpolate(const TableVector<double>& table, Node n, int width, double* out) {
-    const double* a = table.data() + n.i * static_cast<std::size_t>(width);
-    const double* b = a + width;
+  // out[k] = table row i + f (row i + 1 - row i), k < width; rows `stride` apart.
+  static void interpolate(const double* table, std::size_t stride, Node n, int width, double* out) {
+    const double* a = table + n.i * stride;
+    const double* b = a + stride;
     for (int k = 0; k < width; ++k) out[k] = a[k] + n.f * (b[k] - a[k]);
   }
+  // Values per altitude node in coefficients_: sigma_t, sigma_s, sigma_s per scatterer.
+  std::size_t node_width() const { return static_cast<std::size_t>((2 + scatterers_) * bins_); }
 
   void build_coefficients(const Atmosphere& atmosphere, const SpectralGrid& grid);
   void build_phase(const Atmosphere& atmosphere, const SpectralGrid& grid);
 
   int bins_ = 0, scatterers_ = 0, altitude_samples_ = 0, phase_samples_ = 0, terms_ = 0, padded_terms_ = 0;
   double R_ = 0.0, R_top_ = 0.0, dh_ = 0.0, inv_dh_ = 0.0;
-  TableVector<double> sigma_t_, sigma_s_, sigma_s_c_;  // [node][bin], [node][c][bin]
+  // [node][sigma_t bins | sigma_s bins | sigma_s,c bins per scatterer]: one
+  // block (2 MiB, one huge page, for the Earth at 32 bins) that a look-up
+  // reads at one place per node.
+  TableVector<double> coefficients_;
   std::vector<PhaseFunction> phase_functions_;         // [c][bin]
   TableVector<double> phase_table_;                    // [x node][c][bin]
   std::vector<double> albedo_;                         // [bin]
