@@ -23,6 +23,9 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
   plan.adaptive = !lut && request.quality.adaptive && plan.passes >= 2;
+  // An observer on the ground sees one ground point in every downward
+  // direction (common/film/ground_pool.h).
+  if (!lut && request.location.altitude_m == 0.0) plan.pooled_ground_row = first_ground_row(request.camera);
   return plan;
 }
 

@@ -39,7 +39,9 @@
 // common/render/sample_allocation.h); absent: the plan's uniform count.
 //
 // Versioning: READY carries kProtocolVersion (2 since samples_per_pass: a
-// version 1 worker would ignore it and render the wrong samples); the server refuses another
+// version 1 worker would ignore it and render the wrong samples; 3 since the
+// pooled ground of an observer at 0 m, render_plan.h: a version 2 worker
+// would trace every sample of those pixels); the server refuses another
 // version with a fatal DISCONNECT.  Decoding is strict: an unknown command, a
 // header that is not a JSON object, a missing or mistyped field, a value out
 // of range or a wrong frame count throws WireError (the receivers count such
@@ -59,7 +61,7 @@
 
 namespace skyfarm::api {
 
-inline constexpr int kProtocolVersion = 2;
+inline constexpr int kProtocolVersion = 3;
 // The READY capability "probe" of a worker that runs probe units.
 inline constexpr int kProbeUnitsVersion = 1;
 

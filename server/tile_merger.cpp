@@ -6,6 +6,7 @@
 #include <iterator>
 
 #include "common/film/error_estimate.h"
+#include "common/film/ground_pool.h"
 #include "common/film/mirror_image.h"
 #include "common/image/atomic_file.h"
 #include "server/job_service.h"
@@ -92,14 +93,34 @@ int TileMerger::complete_passes() const {
   return passes;
 }
 
+// The pooled ground pixels' sums over every tile, in tile order (ground_pool.h).
+GroundPool TileMerger::ground_pool() const {
+  GroundPool pool(plan_.pooled_ground_row, plan_.batches);
+  if (pool.active())
+    for (int t = 0; t < plan_.tile_count(); ++t) pool.add(tile(t));
+  return pool;
+}
+
 void TileMerger::resolve(Image* image) const {
-  for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(tile(t));
+  const GroundPool pool = ground_pool();
+  for (int t = 0; t < plan_.tile_count(); ++t) {
+    if (pool.active())
+      image->resolve(pool.apply(tile(t)));
+    else
+      image->resolve(tile(t));
+  }
   if (plan_.mirrored) mirror_left_half(image);
 }
 
 ErrorSums TileMerger::error_sums(const std::vector<std::uint32_t>& excluded) const {
+  const GroundPool pool = ground_pool();
   ErrorSums sums;
-  for (int t = 0; t < plan_.tile_count(); ++t) sums.add(skyfarm::error_sums(tile(t), excluded, plan_.width));
+  for (int t = 0; t < plan_.tile_count(); ++t) {
+    if (pool.active())
+      sums.add(skyfarm::error_sums(pool.apply(tile(t)), excluded, plan_.width));
+    else
+      sums.add(skyfarm::error_sums(tile(t), excluded, plan_.width));
+  }
   return sums;
 }
 

@@ -24,6 +24,7 @@
 
 #include "common/film/error_estimate.h"
 #include "common/film/film_tile.h"
+#include "common/film/ground_pool.h"
 #include "common/film/image.h"
 #include "common/render/render_plan.h"
 
@@ -85,6 +86,7 @@ class TileMerger {
   void load();
   // The tile's sums, from memory or disk; keeps the cache within its budget.
   FilmTile& tile(int t) const;
+  GroundPool ground_pool() const;
   std::optional<FilmTile> read_tile(int t, int* units) const;
 
   RenderPlan plan_;

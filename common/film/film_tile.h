@@ -137,6 +137,8 @@ class FilmTile {
   // The sums of pixel (x, y) (image coordinates) in batch b; throws
   // std::out_of_range outside the tile.
   const PixelBatchSums& sums(int x, int y, int batch) const { return data_[index(x, y, batch)]; }
+  // Replaces them (ground_pool.h: pixels that share one pooled estimate).
+  void set_sums(int x, int y, int batch, const PixelBatchSums& sums) { data_[index(x, y, batch)] = sums; }
   // All sums, batch-major: index ((b · height + (y − y0)) · width + (x − x0)).
   const std::vector<PixelBatchSums>& data() const { return data_; }
   std::uint64_t rejected_samples() const { return rejected_; }

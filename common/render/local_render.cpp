@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/film/error_estimate.h"
+#include "common/film/ground_pool.h"
 #include "common/film/mirror_image.h"
 #include "common/render/parallel.h"
 #include "common/render/render_progress.h"
@@ -16,13 +17,23 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// The plan's pooled ground pixels over the frame's tiles, in tile order.
+GroundPool ground_pool(const RenderPlan& plan, const std::vector<FilmTile>& film) {
+  GroundPool pool(plan.pooled_ground_row, plan.batches);
+  if (pool.active())
+    for (const auto& tile : film) pool.add(tile);
+  return pool;
+}
 }  // namespace
 
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,
                                const RenderProgress& progress) {
   const RenderPlan& plan = renderer.plan();
-  // An adaptive plan's tiles wait for the whole frame's pilot.
-  if (plan.adaptive) return render_image_progressive(renderer, image, threads, StopCriteria{}, progress);
+  // An adaptive plan's tiles wait for the whole frame's pilot; pooled ground
+  // pixels need every tile's sums before any is resolved.
+  if (plan.adaptive || plan.pooled_ground_row >= 0)
+    return render_image_progressive(renderer, image, threads, StopCriteria{}, progress);
   const int tiles = plan.tile_count();
   struct TileStats {
     PathCounters counters;
@@ -87,15 +98,29 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     if (p == 0 && plan.adaptive) r.allocation = SampleAllocation::from_pilot(plan, film, renderer.sun_pixels());
     r.samples_per_pixel = r.allocation ? r.allocation->mean_samples_per_pixel(plan, r.passes)
                                        : plan.samples_after(r.passes);
+    const GroundPool pool = ground_pool(plan, film);
     ErrorSums error;
-    for (const auto& tile : film) error.add(error_sums(tile, renderer.sun_pixels(), plan.width));  // tile order
+    for (const auto& tile : film) {  // tile order
+      if (pool.active())
+        error.add(error_sums(pool.apply(tile), renderer.sun_pixels(), plan.width));
+      else
+        error.add(error_sums(tile, renderer.sun_pixels(), plan.width));
+    }
     r.estimate = error.relative_rms();
     r.estimated_relative_rms = r.estimate.value_or(0.0);
     r.pixels_without_estimate = error.unknown;
     r.error = error;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     r.history.emplace_back(elapsed, r.estimated_relative_rms);
-    if (stop.after_pass) stop.after_pass(p + 1, film, elapsed);
+    if (stop.after_pass) {  // the film as the image shows it
+      if (pool.active()) {
+        std::vector<FilmTile> shown;
+        for (const auto& tile : film) shown.push_back(pool.apply(tile));
+        stop.after_pass(p + 1, shown, elapsed);
+      } else {
+        stop.after_pass(p + 1, film, elapsed);
+      }
+    }
     if (p + 1 == plan.passes) break;
     if (stop.target_relative_error && r.estimate && *r.estimate <= *stop.target_relative_error) {
       r.stopped_by = "target_error";
@@ -106,7 +131,13 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       break;
     }
   }
-  for (const auto& tile : film) image->resolve(tile);
+  const GroundPool pool = ground_pool(plan, film);
+  for (const auto& tile : film) {
+    if (pool.active())
+      image->resolve(pool.apply(tile));
+    else
+      image->resolve(tile);
+  }
   if (plan.mirrored) mirror_left_half(image);
   for (const auto& c : counters) r.counters.add(c);
   return r;

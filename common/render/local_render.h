@@ -39,7 +39,8 @@ LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int t
 struct StopCriteria {
   std::optional<double> target_relative_error;
   std::optional<double> time_limit_s;
-  // Called after every whole pass with (passes done, the film's tiles, elapsed s): for benchmarks.
+  // Called after every whole pass with (passes done, the film's tiles as the
+  // image shows them, i.e. with a pooled ground applied, elapsed s): for benchmarks.
   std::function<void(int, const std::vector<FilmTile>&, double)> after_pass;
 };
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/core/constants.h"
 #include "common/sampling/sampler.h"
 #include "common/spectrum/wavelength_sampling.h"
 
@@ -39,6 +40,11 @@ int RenderPlan::block_of(int tile, int x, int y) const {
 }
 
 void RenderPlan::sample_range(const WorkUnit& u, int x, int y, int* first, int* end) const {
+  if (ground_pooled(y)) {  // passes <= samples_per_pixel, so sample u.pass exists
+    *first = u.pass;
+    *end = u.pass + 1;
+    return;
+  }
   *first = pass_first_sample(u.pass);
   *end = pass_end_sample(u.pass);
   const int n = u.pass > 0 && !u.samples.empty() ? u.samples[static_cast<std::size_t>(block_of(u.tile, x, y))].of(x, y) : 0;
@@ -98,6 +104,15 @@ RenderPlan make_render_plan(int width, int height, double lambda_min_nm, double 
 }  // namespace skyfarm
 
 namespace skyfarm {
+
+int first_ground_row(const CameraSpec& camera) {
+  if (camera.projection != Projection::kEquirectangular) return -1;
+  if (camera.pitch_deg != 0.0 || camera.roll_deg != 0.0) return -1;
+  // Camera::film_to_direction: the zenith component is cos(pi fy / height).
+  for (int y = camera.height / 2; y < camera.height; ++y)
+    if (std::cos(kPi * static_cast<double>(y) / camera.height) < 0.0) return y;
+  return -1;
+}
 
 bool mirror_symmetric(const CameraSpec& camera, double sun_azimuth_deg, int tile_size) {
   if (camera.projection != Projection::kEquirectangular) return false;

@@ -70,6 +70,13 @@ struct RenderPlan {
   // request asks for it ("quality.adaptive").
   bool adaptive = false;
   static constexpr int kAllocationBlock = 8;
+  // The ground under an observer at 0 m (DESIGN §3.5, film/ground_pool.h):
+  // rows [pooled_ground_row, height) look only at the ground at the
+  // observer's feet, all with the same radiance; each of their pixels traces
+  // one sample per pass (sample index = the pass) and their sums are pooled
+  // before the image is resolved.  -1: none.
+  int pooled_ground_row = -1;
+  bool ground_pooled(int y) const { return pooled_ground_row >= 0 && y >= pooled_ground_row; }
   int rendered_width() const { return mirrored ? width / 2 : width; }
 
   int tile_count() const { return tiles_x * tiles_y; }
@@ -91,7 +98,8 @@ struct RenderPlan {
   int block_count(int tile) const;
   int block_of(int tile, int x, int y) const;
   // Samples [*first, *end) of pixel (x, y) in unit u (the pass's uniform
-  // range, or u.samples' count for the pixel's parity after the pilot).
+  // range, or u.samples' count for the pixel's parity after the pilot; the
+  // one sample u.pass for a pooled ground pixel).
   void sample_range(const WorkUnit& u, int x, int y, int* first, int* end) const;
   // Samples in pass p >= 1 of a pixel allocated n per pass.
   int allocated_samples(int pass, int n) const;
@@ -120,5 +128,12 @@ RenderPlan make_render_plan(int width, int height, double lambda_min_nm, double 
 // a width of whole tile pairs.  The atmosphere is horizontally uniform and the
 // observer on the plane, so the sky is mirror-symmetric about it.
 bool mirror_symmetric(const CameraSpec& camera, double sun_azimuth_deg, int tile_size = 32);
+
+// The first row of an image whose every film point looks below the horizon
+// (RenderPlan::pooled_ground_row), for an observer at 0 m: equirectangular
+// views with no pitch or roll, where row y spans zenith angles pi [y, y + 1)
+// / height, so the rows from the first y with cos(pi y / height) < 0 on; -1
+// for other cameras or when no row qualifies.
+int first_ground_row(const CameraSpec& camera);
 
 }  // namespace skyfarm

@@ -426,6 +426,7 @@ TEST(JobService, MirroredJobRendersHalfAndMatchesTheLocalRender) {
   const auto before = *service.status(id);
   EXPECT_EQ(before["plan"]["mirrored"], true);
   EXPECT_EQ(before["plan"]["tiles"], 1);  // the left 32 columns
+  EXPECT_EQ(before["plan"]["pooled_ground_row"], 17);  // an observer at 0 m: rows 17-31 see only the ground
   std::mt19937 rng(6);
   run_shuffled(service, rng, 4);
   ASSERT_EQ((*service.status(id))["state"], "done");
