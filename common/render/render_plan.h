@@ -74,7 +74,9 @@ struct RenderPlan {
   // rows [pooled_ground_row, height) look only at the ground at the
   // observer's feet, all with the same radiance; each of their pixels traces
   // one sample per pass (sample index = the pass) and their sums are pooled
-  // before the image is resolved.  -1: none.
+  // before the image is resolved.  Exact because the ground is one Lambertian
+  // sphere and the atmosphere horizontally uniform (a scene with surfaces on
+  // the ground would not qualify).  -1: none.
   int pooled_ground_row = -1;
   bool ground_pooled(int y) const { return pooled_ground_row >= 0 && y >= pooled_ground_row; }
   int rendered_width() const { return mirrored ? width / 2 : width; }
