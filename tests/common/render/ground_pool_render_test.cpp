@@ -100,6 +100,16 @@ TEST(GroundPoolRender, PooledGroundAgreesWithTheTracedGroundAndTheSkyIsTheSameBi
   const double se_traced = sd / std::sqrt(n), se_pooled = 4.0 * se_traced;
   EXPECT_GT(value, 0.0);
   EXPECT_NEAR(value, mean, 4.0 * std::hypot(se_traced, se_pooled)) << "relative se " << se_traced / mean;
+  // What makes pooling exact: the traced ground is one value in every
+  // direction, the rows just below the horizon (17-23) as the ones towards
+  // the nadir (24-31) (a ray that missed the ground at the observer's feet
+  // would meet it hundreds of km away, under another sun).
+  double near = 0.0, down = 0.0;
+  for (int x = 0; x < 64; ++x) {
+    for (int y = 17; y < 24; ++y) near += traced.luminance(x, y) / (7 * 64);
+    for (int y = 24; y < 32; ++y) down += traced.luminance(x, y) / (8 * 64);
+  }
+  EXPECT_NEAR(near, down, 4.0 * sd * std::sqrt(1.0 / (7 * 64) + 1.0 / (8 * 64)));
   // The pooled frame's estimate counts its ground pixels' variance as that of the pooled mean.
   ASSERT_TRUE(rp.estimate && rt.estimate);
   EXPECT_LT(*rp.estimate, *rt.estimate);
