@@ -103,24 +103,17 @@ GroundPool TileMerger::ground_pool() const {
 
 void TileMerger::resolve(Image* image) const {
   const GroundPool pool = ground_pool();
-  for (int t = 0; t < plan_.tile_count(); ++t) {
-    if (pool.active())
-      image->resolve(pool.apply(tile(t)));
-    else
-      image->resolve(tile(t));
-  }
+  std::optional<FilmTile> scratch;
+  for (int t = 0; t < plan_.tile_count(); ++t) image->resolve(pool.shown(tile(t), &scratch));
   if (plan_.mirrored) mirror_left_half(image);
 }
 
 ErrorSums TileMerger::error_sums(const std::vector<std::uint32_t>& excluded) const {
   const GroundPool pool = ground_pool();
   ErrorSums sums;
-  for (int t = 0; t < plan_.tile_count(); ++t) {
-    if (pool.active())
-      sums.add(skyfarm::error_sums(pool.apply(tile(t)), excluded, plan_.width));
-    else
-      sums.add(skyfarm::error_sums(tile(t), excluded, plan_.width));
-  }
+  std::optional<FilmTile> scratch;
+  for (int t = 0; t < plan_.tile_count(); ++t)
+    sums.add(skyfarm::error_sums(pool.shown(tile(t), &scratch), excluded, plan_.width));
   return sums;
 }
 

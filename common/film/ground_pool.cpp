@@ -52,4 +52,10 @@ FilmTile GroundPool::apply(const FilmTile& tile) const {
   return out;
 }
 
+const FilmTile& GroundPool::shown(const FilmTile& tile, std::optional<FilmTile>* scratch) const {
+  int y0 = 0, y1 = 0;
+  if (!pooled_rows(tile, &y0, &y1)) return tile;
+  return scratch->emplace(apply(tile));
+}
+
 }  // namespace skyfarm

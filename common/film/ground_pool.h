@@ -15,6 +15,7 @@
 // tile order), each tile batch by batch, row by row, so the farm and a local
 // render pool the same sums into the same bits.
 #pragma once
+#include <optional>
 #include <vector>
 
 #include "common/film/film_tile.h"
@@ -33,6 +34,9 @@ class GroundPool {
   const PixelBatchSums& sums(int batch) const { return sums_[static_cast<std::size_t>(batch)]; }
   // A copy of tile whose pooled pixels hold the pooled sums.
   FilmTile apply(const FilmTile& tile) const;
+  // The tile as the image shows it: tile itself when none of its rows is
+  // pooled (no copy: the sky's tiles), else apply(tile), kept in *scratch.
+  const FilmTile& shown(const FilmTile& tile, std::optional<FilmTile>* scratch) const;
 
  private:
   bool pooled_rows(const FilmTile& tile, int* y_begin, int* y_end) const;

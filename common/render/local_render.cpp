@@ -78,6 +78,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
   r.stopped_by = "samples";
   std::int64_t done = 0;  // units (tile passes): 131072 x 65536 for the largest open-ended frame
   std::mutex mutex;
+  GroundPool pool(plan.pooled_ground_row, plan.batches);  // of the film after each pass
   for (int p = 0; p < plan.passes; ++p) {
     parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
       FilmTile pass = renderer.empty_tile(static_cast<int>(t));
@@ -98,14 +99,11 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     if (p == 0 && plan.adaptive) r.allocation = SampleAllocation::from_pilot(plan, film, renderer.sun_pixels());
     r.samples_per_pixel = r.allocation ? r.allocation->mean_samples_per_pixel(plan, r.passes)
                                        : plan.samples_after(r.passes);
-    const GroundPool pool = ground_pool(plan, film);
+    pool = ground_pool(plan, film);
     ErrorSums error;
-    for (const auto& tile : film) {  // tile order
-      if (pool.active())
-        error.add(error_sums(pool.apply(tile), renderer.sun_pixels(), plan.width));
-      else
-        error.add(error_sums(tile, renderer.sun_pixels(), plan.width));
-    }
+    std::optional<FilmTile> scratch;
+    for (const auto& tile : film)  // tile order
+      error.add(error_sums(pool.shown(tile, &scratch), renderer.sun_pixels(), plan.width));
     r.estimate = error.relative_rms();
     r.estimated_relative_rms = r.estimate.value_or(0.0);
     r.pixels_without_estimate = error.unknown;
@@ -115,7 +113,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     if (stop.after_pass) {  // the film as the image shows it
       if (pool.active()) {
         std::vector<FilmTile> shown;
-        for (const auto& tile : film) shown.push_back(pool.apply(tile));
+        for (const auto& tile : film) shown.push_back(pool.shown(tile, &scratch));
         stop.after_pass(p + 1, shown, elapsed);
       } else {
         stop.after_pass(p + 1, film, elapsed);
@@ -131,13 +129,8 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       break;
     }
   }
-  const GroundPool pool = ground_pool(plan, film);
-  for (const auto& tile : film) {
-    if (pool.active())
-      image->resolve(pool.apply(tile));
-    else
-      image->resolve(tile);
-  }
+  std::optional<FilmTile> scratch;
+  for (const auto& tile : film) image->resolve(pool.shown(tile, &scratch));  // the last pass's pool
   if (plan.mirrored) mirror_left_half(image);
   for (const auto& c : counters) r.counters.add(c);
   return r;

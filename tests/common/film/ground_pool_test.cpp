@@ -46,6 +46,13 @@ TEST(GroundPool, SumsThePooledRowsOfEveryTileAndReplacesThemOnly) {
   EXPECT_EQ(pooled.luminance_variance_of_mean(1, 6), pooled.luminance_variance_of_mean(2, 5));
   const FilmTile untouched = pool.apply(top);
   EXPECT_EQ(untouched.sums(2, 3, 0).sum_y, top.sums(2, 3, 0).sum_y);
+  // shown(): a tile without pooled rows is itself (no copy), one with them the pooled copy.
+  std::optional<FilmTile> scratch;
+  EXPECT_EQ(&pool.shown(top, &scratch), &top);
+  EXPECT_FALSE(scratch.has_value());
+  const FilmTile& shown = pool.shown(bottom, &scratch);
+  EXPECT_NE(&shown, &bottom);
+  EXPECT_EQ(shown.sums(1, 6, 0).n, n);
 }
 
 TEST(GroundPool, InactiveBelowZeroAndRejectsOtherBatchCounts) {
