@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "common/core/constants.h"
 #include "common/lut/bilinear.h"
-#include "common/lut/fibonacci_directions.h"
 #include "common/lut/invalid_argument.h"
 #include "common/lut/segment_integral.h"
 #include "common/lut/shell_geometry.h"
@@ -15,6 +15,7 @@ namespace skyfarm {
 
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
+constexpr double kGoldenRatio = 1.6180339887498949;  // (1 + sqrt 5) / 2
 
 // acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
 // look-up with its weights given (lut::BilinearF::weighted_add).
@@ -22,6 +23,34 @@ inline void weighted_add4(std::size_t B, const float* v00, const float* v01, con
                           float w00, float w01, float w10, float w11, const float* weight, float* __restrict acc) {
   for (std::size_t b = 0; b < B; ++b)
     acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
+}
+// The direction set (header): `rings` zenith cosines, each carrying the
+// mirror pair of azimuths (phi_i, -phi_i) about the sun's vertical plane.
+// Both directions of a pair see the same sun (x_t . s depends on cos phi
+// only), so one is evaluated for both.  On each side of the horizon mu_h the
+// rings are the midpoints of v in [0, 1] with mu = mu_h +- (range) v^2, so
+// that they crowd towards the horizon, where the scattered light changes
+// fastest (the grazing rays' long paths); sides get rings in proportion to
+// their solid angle.  Weights (dmu dphi / 4 pi) sum to 1.  phi_i steps by the
+// golden angle, as in a spherical Fibonacci set.
+struct Rings {
+  std::vector<double> mu, weight, cos_phi;
+};
+
+Rings mirrored_rings(int rings, double mu_h) {
+  Rings out;
+  const int n_ground = std::clamp(static_cast<int>(std::lround(0.5 * rings * (1.0 + mu_h))), 1, rings - 1);
+  const int n_sky = rings - n_ground;
+  for (int i = 0; i < rings; ++i) {
+    const bool sky = i < n_sky;
+    const int n = sky ? n_sky : n_ground;
+    const double range = sky ? 1.0 - mu_h : 1.0 + mu_h;
+    const double v = sky ? 1.0 - (i + 0.5) / n_sky : (i - n_sky + 0.5) / n_ground;
+    out.mu.push_back(sky ? mu_h + range * v * v : mu_h - range * v * v);
+    out.weight.push_back(0.5 * range * 2.0 * v / n);
+    out.cos_phi.push_back(std::cos(2.0 * kPi * i / kGoldenRatio));
+  }
+  return out;
 }
 }  // namespace
 
@@ -37,22 +66,23 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   m.n_h_ = altitude_samples;
   m.top_altitude_ = medium.top_altitude_m();
   const std::size_t B = static_cast<std::size_t>(m.bins_), S = static_cast<std::size_t>(steps);
-  const std::size_t D = static_cast<std::size_t>(directions);
+  const int ring_count = std::max(2, directions / 2);
+  const std::size_t N = static_cast<std::size_t>(ring_count);
   const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
   m.values_.assign(static_cast<std::size_t>(altitude_samples * mu_s_samples) * B, 0.0f);
-  const std::vector<glm::dvec3> dirs = lut::fibonacci_sphere(directions);
   const std::vector<double>& albedo = medium.ground_albedo();
   const TransmittanceLut::RadiusCoord ground_rc = transmittance.locate_r(R);
 
-  // Per altitude row, everything that does not depend on the sun: the
-  // weights T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of every step,
-  // the step's T-LUT radius, and mu_s at the step as a sin_s + b mu_s.
-  // (W and the sums over the samples in single precision, as the tables: bilinear.h.)
-  std::vector<float> W(D * S * B);
-  std::vector<double> T_ground(D * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
-  std::vector<TransmittanceLut::RadiusCoord> rc(D * S);
-  std::vector<double> a(D * S), bcoef(D * S), a_g(D), b_g(D), t_mid(S), dt(S);
-  std::vector<char> hits(D);
+  // Per altitude row and ring, everything that does not depend on the sun:
+  // the weights w_ring T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of
+  // every step (the ring's mirror pair together), the step's T-LUT radius,
+  // and mu_s at the step as a sin_s + b mu_s.  (W and the sums over the samples in single
+  // precision, as the tables: bilinear.h.)
+  std::vector<float> W(N * S * B);
+  std::vector<double> T_ground(N * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
+  std::vector<TransmittanceLut::RadiusCoord> rc(N * S);
+  std::vector<double> a(N * S), bcoef(N * S), a_g(N), b_g(N), w_dir(N), t_mid(S), dt(S);
+  std::vector<char> hits(N);
   const std::size_t M = static_cast<std::size_t>(mu_s_samples);
   std::vector<double> mu_s(M), sin_s(M), u_T(M);
   std::vector<float> L_all(M * B), w00(M), w01(M), w10(M), w11(M);
@@ -64,9 +94,10 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   for (int j = 0; j < altitude_samples; ++j) {
     const double r = R + m.top_altitude_ * j / (altitude_samples - 1);
     std::fill(f_ms.begin(), f_ms.end(), 0.0);
-    for (std::size_t i = 0; i < D; ++i) {
-      const glm::dvec3& w = dirs[i];
-      const double mu = w.z;
+    const Rings rings = mirrored_rings(ring_count, lut::horizon_mu(r, R));
+    for (std::size_t i = 0; i < N; ++i) {
+      const double mu = rings.mu[i], sin_theta = std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
+      w_dir[i] = rings.weight[i];
       hits[i] = lut::ray_hits_ground(r, mu, R);
       const double t_end = hits[i] ? lut::distance_to_ground(r, mu, R) : lut::distance_to_top(r, mu, R_top);
       lut::place_steps(r, mu, t_end, steps, t_mid.data(), dt.data());
@@ -81,24 +112,23 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
           double integral;
           const double T_seg = lut::T_and_in_scattering_integral(s_t[b], dt[k], &integral);
           const double w = T_acc[b] * integral * s_s[b];
-          Wk[b] = static_cast<float>(w);
-          f_ms[b] += w;
+          Wk[b] = static_cast<float>(w * w_dir[i]);
+          f_ms[b] += w * w_dir[i];
           T_acc[b] *= T_seg;
         }
         rc[i * S + k] = transmittance.locate_r(rk);
-        // x_t = (0, 0, r) + t w, s = (sin_s, 0, mu_s): x_t . s / r_t.
-        a[i * S + k] = t_mid[k] * w.x / rk;
-        bcoef[i * S + k] = (r + t_mid[k] * w.z) / rk;
+        // x_t = (0, 0, r) + t w, w = (sin_theta cos_phi, +-sin_theta sin_phi, mu),
+        // s = (sin_s, 0, mu_s): x_t . s / r_t = a sin_s + b mu_s.
+        a[i * S + k] = t_mid[k] * sin_theta * rings.cos_phi[i] / rk;
+        bcoef[i * S + k] = (r + t_mid[k] * mu) / rk;
       }
       if (hits[i]) {
-        std::copy(T_acc.begin(), T_acc.end(), T_ground.begin() + static_cast<std::ptrdiff_t>(i * B));
-        a_g[i] = t_end * w.x / R;
-        b_g[i] = (r + t_end * w.z) / R;
+        for (std::size_t b = 0; b < B; ++b) T_ground[i * B + b] = T_acc[b] * w_dir[i];
+        a_g[i] = t_end * sin_theta * rings.cos_phi[i] / R;
+        b_g[i] = (r + t_end * mu) / R;
       }
     }
-    // f_ms = int p_u (...) dw = mean over the directions (p_u 4 pi / n = 1 / n).
     for (std::size_t b = 0; b < B; ++b) {
-      f_ms[b] /= static_cast<double>(D);
       if (!(f_ms[b] <= kMaxFms)) {
         f_ms[b] = kMaxFms;
         ++m.clamped_;
@@ -113,8 +143,9 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
     std::fill(L_all.begin(), L_all.end(), 0.0f);
     const std::size_t stride = transmittance.radius_stride();
     const int last_node = transmittance.mu_samples() - 2;
-    for (std::size_t q = 0; q < D * S; ++q) {
+    for (std::size_t q = 0; q < N * S; ++q) {
       const float fj = static_cast<float>(rc[q].fj), gj = 1.0f - fj;
+      const float* Wq = W.data() + q * B;
       for (std::size_t col = 0; col < M; ++col) {
         const double mu_q = std::min(1.0, std::max(-1.0, a[q] * sin_s[col] + bcoef[q] * mu_s[col]));
         u_T[col] = transmittance.mu_position(rc[q], mu_q);
@@ -126,7 +157,6 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         w10[col] = fj * (1.0f - f);
         w11[col] = fj * f;
       }
-      const float* Wq = W.data() + q * B;
       for (std::size_t col = 0; col < M; ++col)
         if (u_T[col] >= 0.0) {
           const float* v = transmittance.node_values(rc[q], static_cast<std::size_t>(node[col]));
@@ -140,7 +170,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
       for (std::size_t b = 0; b < B; ++b) L[b] *= kInv4Pi;  // the sun's phase p_u
       // The ground's Lambertian reflection of the attenuated sun (Hillaire's code,
       // IntegrateScatteredLuminance "bounced light off the earth").
-      for (std::size_t i = 0; i < D; ++i) {
+      for (std::size_t i = 0; i < N; ++i) {
         if (!hits[i]) continue;
         const double mu_g = std::clamp(a_g[i] * sin_s[col] + b_g[i] * mu_s[col], -1.0, 1.0);
         if (mu_g <= 0.0) continue;
@@ -148,7 +178,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         for (std::size_t b = 0; b < B; ++b) L[b] += T_ground[i * B + b] * T_sun[b] * mu_g * albedo[b] * kInvPi;
       }
       float* out = m.values_.data() + (static_cast<std::size_t>(j) * mu_s_samples + col) * B;
-      for (std::size_t b = 0; b < B; ++b) out[b] = static_cast<float>((L[b] / static_cast<double>(D)) / (1.0 - f_ms[b]));
+      for (std::size_t b = 0; b < B; ++b) out[b] = static_cast<float>(L[b] / (1.0 - f_ms[b]));
     }
   }
   return m;
