@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -97,6 +98,42 @@ TEST(LutMultipleScattering, DenseConservativeMediumIsClampedAndCounted) {
     ms.psi(0.0, mu_s, psi.data());
     for (double v : psi) EXPECT_TRUE(std::isfinite(v) && v >= 0.0);
   }
+}
+
+
+// The direction set's quadrature error: the default 64 directions (32
+// mirror pairs crowded towards the horizon) against 1024 of the same kind,
+// Earth preset, every daytime node (mu_s >= 0) and bin.  Measured: RMS
+// relative difference 0.14 %, worst 2.7 % (the sun 86 deg from the zenith,
+// where few directions see it through little air).  (The 64 spherical-
+// Fibonacci directions used before: 0.41 % RMS against a 4096-direction
+// reference at 32 x 32 nodes and 32 bins, this set 0.17 %.)
+TEST(LutMultipleScattering, DefaultDirectionsMatchAConvergedTable) {
+  const Atmosphere atm = build_atmosphere(AtmosphereSpec{});
+  const SpectralGrid grid(360.0, 830.0, 8);
+  const MediumTable medium = MediumTable::build(atm, grid);
+  const TransmittanceLut T = TransmittanceLut::build(medium);
+  const MultipleScatteringLut ms = MultipleScatteringLut::build(medium, T, 16, 16, 64, 20);
+  const MultipleScatteringLut ref = MultipleScatteringLut::build(medium, T, 16, 16, 1024, 20);
+  std::vector<double> a(8), b(8);
+  double sum_d2 = 0.0, sum_r2 = 0.0, worst = 0.0;
+  for (int j = 0; j < 16; ++j) {
+    for (int c = 8; c < 16; ++c) {
+      const double h = 100000.0 * j / 15.0, mu_s = -1.0 + 2.0 * c / 15.0;
+      ms.psi(h, mu_s, a.data());
+      ref.psi(h, mu_s, b.data());
+      for (std::size_t k = 0; k < a.size(); ++k) {
+        sum_d2 += (a[k] - b[k]) * (a[k] - b[k]);
+        sum_r2 += b[k] * b[k];
+        worst = std::max(worst, std::abs(a[k] - b[k]) / b[k]);
+      }
+    }
+  }
+  const double rms = std::sqrt(sum_d2 / sum_r2);
+  RecordProperty("rms_relative", std::to_string(rms));
+  RecordProperty("worst_relative", std::to_string(worst));
+  EXPECT_LT(rms, 0.003);
+  EXPECT_LT(worst, 0.04);
 }
 
 }  // namespace
