@@ -10,7 +10,8 @@
 //   phase_samples              tabulated phase function nodes (512)
 //   transmittance_mu/_r/_steps 256 x 128 nodes, 64 quadrature intervals per
 //                              part of a ray (transmittance_lut.h)
-//   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions, 20 steps
+//   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions (32 mirror-
+//                              paired rings), 20 steps
 //   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
 //   sky_view_*                 192 azimuths x 108 zenith rows, 30 steps
 //   aerial_*                   32 x 32 x 32 slices up to 64 km
