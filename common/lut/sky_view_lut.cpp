@@ -35,6 +35,17 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
     const double mu = std::cos(theta), sin_theta = std::sin(theta);
     const double t_end = hits_ground ? lut::distance_to_ground(r, mu, R) : lut::distance_to_top(r, mu, R_top);
     march.prepare(r, mu, t_end, hits_ground, steps);
+    float* out = s.values_.data() + static_cast<std::size_t>(row) * cols * B;
+    if (hits_ground && t_end == 0.0) {
+      // Looking down from the ground itself (an observer at 0 m): no air in
+      // between, and the ground at the observer's feet, whatever the azimuth
+      // (add_ground's nu enters only as t_end nu): one value for the row.
+      std::fill(L.begin(), L.begin() + static_cast<std::ptrdiff_t>(B), 0.0);
+      march.add_ground(0.0, mu_s, L.data());
+      for (std::size_t col = 0; col < cols; ++col)
+        for (std::size_t b = 0; b < B; ++b) out[col * B + b] = static_cast<float>(L[b] * sun_irradiance[b]);
+      continue;
+    }
     for (std::size_t col = 0; col < cols; ++col) {
       // nu = v . s for v = (sin_theta cos_phi, sin_theta sin_phi, mu), s = (sin_s, 0, mu_s).
       nu[col] = mu * mu_s + sin_theta * sin_s * s.mapping_.cos_phi_of_column(static_cast<int>(col));
@@ -42,7 +53,6 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
     }
     std::fill(L.begin(), L.end(), 0.0);
     march.add_inscattering(static_cast<int>(cols), nu.data(), phase.data(), mu_s, 0, march.steps(), L.data());
-    float* out = s.values_.data() + static_cast<std::size_t>(row) * cols * B;
     for (std::size_t col = 0; col < cols; ++col) {
       double* Lc = L.data() + col * B;
       march.add_ground(nu[col], mu_s, Lc);
