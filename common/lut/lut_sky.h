@@ -61,11 +61,12 @@
 // directions (with an isotropic scatterer the LUT agrees to 1.2 %).
 //
 // Cost (tests/bench/lut_bench.cpp, one core of a shared 2-core AMD EPYC VM,
-// CPU time, medians, 8 / 32 bins): all tables 22 / 33 ms since the
-// multiple-scattering table's mirror-paired directions (26 / 36-40 ms in
+// CPU time, medians, 8 / 32 bins, observer on the ground): all tables
+// 20.5 / 27.6 ms since the multiple-scattering table's mirror-paired
+// directions and the sky view's one-value ground rows (26 / 36-40 ms in
 // quiet runs before; 86 ms at 32 bins before the tables moved to huge
 // pages: page faults cost ~11 us each on this VM); the sun-dependent tables alone (with_sun) 6 /
-// 9.5 ms for an observer on the ground; one radiance look-up 84 / 107-139
+// 7.4 ms for an observer on the ground; one radiance look-up 84 / 107-139
 // ns; memory 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).
 // Where the time goes and what bounds it: docs/physics.md "The LUT sky's
 // build time".  A timelapse or a cache of many suns should build once and
