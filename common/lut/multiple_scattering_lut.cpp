@@ -24,6 +24,7 @@ inline void weighted_add4(std::size_t B, const float* v00, const float* v01, con
   for (std::size_t b = 0; b < B; ++b)
     acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
 }
+
 // The direction set (header): `rings` zenith cosines, each carrying the
 // mirror pair of azimuths (phi_i, -phi_i) about the sun's vertical plane.
 // Both directions of a pair see the same sun (x_t . s depends on cos phi
@@ -76,8 +77,8 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   // Per altitude row and ring, everything that does not depend on the sun:
   // the weights w_ring T(x, x_t) int_seg exp(-sigma_t s) ds sigma_s(x_t) of
   // every step (the ring's mirror pair together), the step's T-LUT radius,
-  // and mu_s at the step as a sin_s + b mu_s.  (W and the sums over the samples in single
-  // precision, as the tables: bilinear.h.)
+  // and mu_s at the step as a sin_s + b mu_s.  (W and the sums over the
+  // samples in single precision, as the tables: bilinear.h.)
   std::vector<float> W(N * S * B);
   std::vector<double> T_ground(N * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
   std::vector<TransmittanceLut::RadiusCoord> rc(N * S);
