@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <span>
 #include <vector>
 
@@ -30,11 +31,11 @@ double x_mu_from_v(double v) { return 1.0 - sqr(sqr(1.0 - v)); }
 class OpticalDepthQuadrature {
  public:
   OpticalDepthQuadrature(const MediumTable& medium, int steps)
-      : medium_(medium), n_(steps + (steps % 2)), u2_(n_), weight_(n_), node_(n_), w0_(n_), w1_(n_) {
+      : medium_(medium), n_(steps + (steps % 2)), u2_(n_), frac_(n_), weight_(n_), node_(n_), w0_(n_), w1_(n_) {
     for (int k = 1; k <= n_; ++k) {  // k = 0 has ds/du = 0
       const double u = static_cast<double>(k) / n_;
       const std::size_t j = static_cast<std::size_t>(k - 1);
-      u2_[j] = u * u;
+      u2_[j] = static_cast<float>(u * u);
       weight_[j] = (k == n_ ? 1.0 : (k % 2 == 1 ? 4.0 : 2.0)) / (3.0 * n_) * 2.0 * u;
     }
   }
@@ -77,41 +78,63 @@ class OpticalDepthQuadrature {
     const double top_node = medium_.altitude_samples() - 1;
     const int last_cell = medium_.altitude_samples() - 2;
     const double d = b - a, l2 = l * l;
+    // The altitudes in single precision (16 per AVX-512 instruction), without
+    // the cancellation of sqrt(l^2 + s^2) - R: with e = s - a = d u^2,
+    //   h = (r_a^2 - R^2 + e (2 a + e)) / (sqrt(l^2 + s^2) + R),
+    // r_a^2 - R^2 = l^2 + a^2 - R^2 in double once per part, and every other
+    // term a sum of non-negative numbers or a ratio (relative error ~1e-7:
+    // 1 cm at 100 km, against 49 m between the medium's nodes).
+    const float c_a = static_cast<float>((l2 + a * a) - R * R), two_a = static_cast<float>(2.0 * a);
+    const float df = static_cast<float>(d), af = static_cast<float>(a), l2f = static_cast<float>(l2);
+    const float Rf = static_cast<float>(R), inv_dhf = static_cast<float>(inv_dh), top = static_cast<float>(top_node);
     // (Locals, not members, in the loops: the compiler cannot prove that the
     // stores leave *this alone, and would not vectorise.)
     const std::size_t n = static_cast<std::size_t>(n_);
-    const double *u2 = u2_.data(), *weight = weight_.data();
+    const float* u2 = u2_.data();
+    const double* weight = weight_.data();
     int* __restrict node = node_.data();
+    float* __restrict frac = frac_.data();
+    for (std::size_t k = 0; k < n; ++k) {
+      const float e = df * u2[k], s = af + e;
+      const float h = (c_a + e * (two_a + e)) / (std::sqrt(l2f + s * s) + Rf);
+      const float x = std::min(std::max(h * inv_dhf, 0.0f), top);  // MediumTable::locate
+      const int i = std::min(static_cast<int>(x), last_cell);
+      node[k] = i;
+      frac[k] = x - static_cast<float>(i);
+    }
     double *__restrict w0 = w0_.data(), *__restrict w1 = w1_.data();
     for (std::size_t k = 0; k < n; ++k) {
-      const double s = a + d * u2[k];
-      const double h = std::sqrt(l2 + s * s) - R;
-      const double x = std::min(std::max(h * inv_dh, 0.0), top_node);  // MediumTable::locate
-      const int i = std::min(static_cast<int>(x), last_cell);
-      const double f = x - i, w = d * weight[k];
-      node[k] = i;
+      const double f = frac[k], w = d * weight[k];
       w0[k] = w * (1.0 - f);
       w1[k] = w * f;
     }
-    // Eight terms at a time, in a local accumulator that stays in registers
-    // (through memory, every sample would wait for the previous store).
+    // Eight terms at a time (one 64-byte block of the medium's profiles), in
+    // two accumulators, the even and the odd samples (n is even), so that a
+    // sample's add does not wait for the previous one's: with one, the add's
+    // latency bounded the loop.  (GCC's vector extension: plain loops over
+    // eight doubles were vectorised with shuffles.  Element-wise, so every
+    // clone gives the same bits.)
+    using Eight = double __attribute__((vector_size(64)));
     const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
     for (std::size_t c = 0; c < K; c += 8) {
-      double acc[8];
-      for (std::size_t j = 0; j < 8; ++j) acc[j] = terms[c + j];
-      for (std::size_t k = 0; k < n; ++k) {
-        const double* p0 = medium_.term_block(static_cast<std::size_t>(node[k]), c);
-        const double* p1 = medium_.term_block(static_cast<std::size_t>(node[k]) + 1, c);
-        const double a0 = w0[k], a1 = w1[k];
-        for (std::size_t j = 0; j < 8; ++j) acc[j] += a0 * p0[j] + a1 * p1[j];
+      Eight even, odd = {};
+      std::memcpy(&even, terms + c, sizeof even);
+      for (std::size_t k = 0; k < n; k += 2) {
+        const Eight* p = reinterpret_cast<const Eight*>(medium_.term_block(static_cast<std::size_t>(node[k]), c));
+        const Eight* q = reinterpret_cast<const Eight*>(medium_.term_block(static_cast<std::size_t>(node[k + 1]), c));
+        const std::size_t next = K / 8;  // the next node's block
+        even += w0[k] * p[0] + w1[k] * p[next];
+        odd += w0[k + 1] * q[0] + w1[k + 1] * q[next];
       }
-      for (std::size_t j = 0; j < 8; ++j) terms[c + j] = acc[j];
+      even += odd;
+      std::memcpy(terms + c, &even, sizeof even);
     }
   }
 
   const MediumTable& medium_;
   int n_;
-  std::vector<double> u2_, weight_;
+  std::vector<float> u2_, frac_;
+  std::vector<double> weight_;
   std::vector<int> node_;
   std::vector<double> w0_, w1_;
 };
