@@ -80,7 +80,8 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   // and mu_s at the step as a sin_s + b mu_s.  (W and the sums over the
   // samples in single precision, as the tables: bilinear.h.)
   std::vector<float> W(N * S * B);
-  std::vector<double> T_ground(N * B), f_ms(B), T_acc(B), s_t(B), s_s(B), L(B), T_sun(B);
+  std::vector<double> T_ground(N * B), f_ms(B), s_t(B), s_s(B), L(B), T_sun(B);
+  std::vector<float> T_acc(B);
   std::vector<TransmittanceLut::RadiusCoord> rc(N * S);
   std::vector<double> a(N * S), bcoef(N * S), a_g(N), b_g(N), w_dir(N), t_mid(S), dt(S);
   std::vector<char> hits(N);
@@ -102,19 +103,23 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
       hits[i] = lut::ray_hits_ground(r, mu, R);
       const double t_end = hits[i] ? lut::distance_to_ground(r, mu, R) : lut::distance_to_top(r, mu, R_top);
       lut::place_steps(r, mu, t_end, steps, t_mid.data(), dt.data());
-      std::fill(T_acc.begin(), T_acc.end(), 1.0);
+      // (The steps' weights in single precision, as W is stored; f_ms sums
+      // them in double.)
+      std::fill(T_acc.begin(), T_acc.end(), 1.0f);
+      const float w_ring = static_cast<float>(w_dir[i]);
       for (std::size_t k = 0; k < S; ++k) {
         const double rk = lut::radius_at(r, mu, t_mid[k]);
         const MediumTable::Node node = medium.locate(rk - R);
         medium.sigma_t(node, s_t.data());
         medium.sigma_s(node, s_s.data());
         float* Wk = W.data() + (i * S + k) * B;
+        const float dt_k = static_cast<float>(dt[k]);
         for (std::size_t b = 0; b < B; ++b) {
-          double integral;
-          const double T_seg = lut::T_and_in_scattering_integral(s_t[b], dt[k], &integral);
-          const double w = T_acc[b] * integral * s_s[b];
-          Wk[b] = static_cast<float>(w * w_dir[i]);
-          f_ms[b] += w * w_dir[i];
+          float integral;
+          const float T_seg = lut::T_and_in_scattering_integral_f(static_cast<float>(s_t[b]), dt_k, &integral);
+          const float w = T_acc[b] * integral * static_cast<float>(s_s[b]) * w_ring;
+          Wk[b] = w;
+          f_ms[b] += w;
           T_acc[b] *= T_seg;
         }
         rc[i * S + k] = transmittance.locate_r(rk);
