@@ -6,12 +6,22 @@
 //
 // Parameters
 //   mu_s_samples   nodes on mu_s in [-1, 1], equally spaced (default 64)
-//   directions     cosine-weighted Fibonacci directions over the upper
-//                  hemisphere (default 64)
+//   directions     directions over the upper hemisphere (default 64):
+//                  directions / 4 rings of zenith, 4 azimuths each
 //   steps          march steps per direction (default 20)
 //
 //   I(mu_s) = int_{upper hemisphere} L_sky(w) cos(theta) dw
-//           ~ (pi / n) sum_i L_sky(w_i)                    (fibonacci_directions.h)
+//           = int_0^1 mu dmu  2 int_0^pi L_sky(mu, phi) dphi
+// (every sun lies in the plane phi = 0, and a horizontally uniform sky is
+// mirror-symmetric about it), by a product rule: rings at the midpoints
+// mu_i = (i + 1/2) / n_mu with weights mu_i / n_mu, and azimuths phi =
+// pi t^2 at the midpoints t_j of [0, 1] with weights 2 pi 2 t_j / n_phi,
+// crowded towards the sun's side, where the aerosols' forward peak is.  A
+// ring's march is prepared once for all its azimuths and suns.  Measured
+// against a 256 x 256 rule (Earth preset, 32 bins, 20 steps), relative
+// error of I: 1.9 % worst by day (mu_s > 0.1), 3.3 % worst in twilight
+// (-0.2 < mu_s <= 0.1), at the cost of the 64 cosine-weighted Fibonacci
+// directions used before, which erred by 4.6 % and 30 %.
 // with L_sky the single-scattering radiance (true phase functions) plus
 // Hillaire's multiple-scattering term, seen from the ground
 // (scattering_march.h).  The ground's own light reflected back down by the
