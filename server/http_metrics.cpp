@@ -5,6 +5,7 @@
 #include <set>
 #include <string_view>
 
+#include "common/core/huge_page_allocator.h"
 #include "server/probe_service.h"
 #include "server/sky_service.h"
 
@@ -161,6 +162,9 @@ void append_sky_cache_metrics(std::string& out, const SkyCacheStats& s) {
          "Sky tables built for a new sun from cached atmosphere tables (LutSky::with_sun).");
   sample(out, "skyfarm_sky_cache_sun_only_builds_total", "cache=\"table\"",
          std::to_string(s.table_sun_only_builds));
+  header(out, "skyfarm_table_memory_recycled_bytes", "gauge",
+         "Freed table memory kept for the next build of the same size (huge_page_allocator.h; at most 64 MiB).");
+  sample(out, "skyfarm_table_memory_recycled_bytes", "", std::to_string(recycled_bytes()));
 }
 
 void append_probe_metrics(std::string& out, const ProbeStats& s) {

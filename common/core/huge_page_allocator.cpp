@@ -3,12 +3,49 @@
 #include <sys/mman.h>
 
 #include <cstdint>
+#include <mutex>
+#include <utility>
+#include <vector>
 
 namespace skyfarm {
 
 namespace {
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kPage = 4096;
+
+// Freed blocks kept for reuse (header), by mapped length.
+struct Recycled {
+  std::mutex mutex;
+  std::vector<std::pair<void*, std::size_t>> blocks;
+  std::size_t bytes = 0;
+};
+Recycled& recycled() {
+  static Recycled* r = new Recycled;  // never destroyed: blocks may be freed during static destruction
+  return *r;
+}
+
+void* take_recycled(std::size_t length) {
+  Recycled& r = recycled();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  for (std::size_t i = 0; i < r.blocks.size(); ++i)
+    if (r.blocks[i].second == length) {
+      void* block = r.blocks[i].first;
+      r.blocks[i] = r.blocks.back();
+      r.blocks.pop_back();
+      r.bytes -= length;
+      return block;
+    }
+  return nullptr;
+}
+
+bool keep_recycled(void* block, std::size_t length) {
+  Recycled& r = recycled();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  if (r.bytes + length > kRecycledMaxBytes) return false;
+  r.blocks.emplace_back(block, length);
+  r.bytes += length;
+  return true;
+}
 
 std::size_t round_up(std::size_t x, std::size_t to) { return (x + to - 1) / to * to; }
 bool in_huge_pages(std::size_t bytes) { return bytes >= kHugePageMinBytes; }
@@ -23,6 +60,7 @@ std::size_t mapped_bytes(std::size_t bytes) {
 
 void* huge_page_map(std::size_t bytes) {
   const std::size_t length = mapped_bytes(bytes);
+  if (void* block = take_recycled(length)) return block;
   if (!in_huge_pages(bytes)) {
     // Too small for a huge page without wasting most of it: pre-faulted in
     // one call (MAP_POPULATE), 2.3x cheaper here than page by page.
@@ -48,7 +86,20 @@ void* huge_page_map(std::size_t bytes) {
 }
 
 void huge_page_unmap(void* p, std::size_t bytes) noexcept {
-  if (p != nullptr) munmap(p, mapped_bytes(bytes));
+  if (p == nullptr) return;
+  const std::size_t length = mapped_bytes(bytes);
+  bool kept = false;
+  try {
+    kept = keep_recycled(p, length);
+  } catch (...) {  // no memory for the list: unmap instead
+  }
+  if (!kept) munmap(p, length);
+}
+
+std::size_t recycled_bytes() {
+  Recycled& r = recycled();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  return r.bytes;
 }
 
 }  // namespace skyfarm

@@ -15,9 +15,16 @@
 // and the tables report it in their memory_bytes().  Blocks of
 // kOwnMappingMinBytes (256 KiB) up to 1 MiB are mapped on their own too,
 // pre-faulted in one call; smaller ones come from operator new (glibc would
-// otherwise mmap and unmap them, faulting every time).  Fresh mappings are
-// zero-filled by the kernel; the containers still value-initialise their
-// elements as usual.
+// otherwise mmap and unmap them, faulting every time).
+//
+// Freed blocks mapped on their own are kept for reuse, up to
+// kRecycledMaxBytes (64 MiB) in all, and handed to the next request of the
+// same mapped size (a table of the same resolution: the sky service builds
+// the same tables again for every new sun or atmosphere); beyond that they
+// are unmapped.  A reused block is already faulted in, and the kernel does
+// not zero it again (zeroing fresh 2 MiB pages was ~5 % of a LUT build).
+// Its old contents are not cleared: the containers value-initialise their
+// elements as usual.  recycled_bytes() says how much is kept.
 #pragma once
 #include <cstddef>
 #include <new>
@@ -27,6 +34,7 @@ namespace skyfarm {
 
 inline constexpr std::size_t kOwnMappingMinBytes = std::size_t{256} << 10;
 inline constexpr std::size_t kHugePageMinBytes = std::size_t{1} << 20;
+inline constexpr std::size_t kRecycledMaxBytes = std::size_t{64} << 20;
 
 // The bytes a block of `bytes` occupies (its mapping, for the blocks mapped on their own).
 std::size_t mapped_bytes(std::size_t bytes);
@@ -34,7 +42,10 @@ std::size_t mapped_bytes(std::size_t bytes);
 // Maps a block of `bytes` (>= kOwnMappingMinBytes) as above; throws
 // std::bad_alloc when the kernel refuses.  huge_page_unmap takes the same size.
 void* huge_page_map(std::size_t bytes);
+// (Or keeps it for reuse, as above.)
 void huge_page_unmap(void* p, std::size_t bytes) noexcept;
+// Bytes of freed blocks kept for reuse.
+std::size_t recycled_bytes();
 
 template <class T>
 struct HugePageAllocator {

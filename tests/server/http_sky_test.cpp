@@ -352,6 +352,8 @@ TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
   EXPECT_NE(m->body.find("skyfarm_sky_cache_bytes{cache=\"table\"} " + std::to_string(service_->stats().table_bytes)),
             std::string::npos);
   EXPECT_NE(m->body.find("skyfarm_sky_cache_sun_only_builds_total{cache=\"table\"} 0\n"), std::string::npos);
+  EXPECT_NE(m->body.find("# TYPE skyfarm_table_memory_recycled_bytes gauge\nskyfarm_table_memory_recycled_bytes "),
+            std::string::npos);
   // Another sun of the same atmosphere: its tables come from the cached ones.
   ASSERT_EQ(c.Get("/v1/sky?sun_zenith=60&sun_azimuth=90&view_zenith=0&view_azimuth=0")->status, 200);
   m = c.Get("/metrics");

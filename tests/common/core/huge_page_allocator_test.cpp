@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstring>
+#include <vector>
 #include <numeric>
 
 namespace skyfarm {
@@ -51,6 +53,33 @@ TEST(HugePageAllocator, MemoryIsCountedAsMapped) {
   TableVector<float> v(3u << 18);
   EXPECT_EQ(table_memory_bytes(v), 2 * kTwoMiB);
   EXPECT_EQ(table_memory_bytes(TableVector<float>{}), 0u);
+}
+
+// Freed blocks are kept and handed out again for the same mapped size, up
+// to kRecycledMaxBytes in all; a vector on a reused block still starts from
+// its own values.
+TEST(HugePageAllocator, FreedBlocksAreReusedWithinABound) {
+  const std::size_t bytes = std::size_t{3} << 20, mapped = 2 * kTwoMiB;
+  void* a = huge_page_map(bytes);
+  const std::size_t kept = recycled_bytes();  // (earlier tests' blocks)
+  ASSERT_LE(kept + mapped, kRecycledMaxBytes);
+  std::memset(a, 0x7f, bytes);
+  huge_page_unmap(a, bytes);
+  EXPECT_EQ(recycled_bytes(), kept + mapped);
+  void* b = huge_page_map(bytes);  // the same size: from the kept blocks
+  EXPECT_EQ(recycled_bytes(), kept);
+  EXPECT_EQ(reinterpret_cast<std::uintptr_t>(b) % kTwoMiB, 0u);
+  huge_page_unmap(b, bytes);
+  {
+    TableVector<float> v(bytes / sizeof(float), 0.5f);  // possibly on the block just freed
+    for (float x : v) ASSERT_EQ(x, 0.5f);
+  }
+  // Never more than the bound, however much is freed.
+  std::vector<void*> blocks;
+  for (std::size_t k = 0; k < 2 * kRecycledMaxBytes / mapped; ++k) blocks.push_back(huge_page_map(bytes));
+  for (void* p : blocks) huge_page_unmap(p, bytes);
+  EXPECT_LE(recycled_bytes(), kRecycledMaxBytes);
+  EXPECT_GE(recycled_bytes() + mapped, kRecycledMaxBytes);
 }
 
 }  // namespace
