@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include "common/core/constants.h"
@@ -15,11 +16,13 @@ namespace skyfarm {
 
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
+constexpr std::size_t kDefaultBins = 32;  // LutResolution's default
 constexpr double kGoldenRatio = 1.6180339887498949;  // (1 + sqrt 5) / 2
 
 // acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
 // look-up with its weights given (lut::BilinearF::weighted_add).
-inline void weighted_add4(std::size_t B, const float* v00, const float* v01, const float* v10, const float* v11,
+template <class Size>
+[[gnu::always_inline]] inline void weighted_add4(Size B, const float* v00, const float* v01, const float* v10, const float* v11,
                           float w00, float w01, float w10, float w11, const float* weight, float* __restrict acc) {
   for (std::size_t b = 0; b < B; ++b)
     acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
@@ -163,12 +166,21 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
         w10[col] = fj * (1.0f - f);
         w11[col] = fj * f;
       }
-      for (std::size_t col = 0; col < M; ++col)
-        if (u_T[col] >= 0.0) {
-          const float* v = transmittance.node_values(rc[q], static_cast<std::size_t>(node[col]));
-          weighted_add4(B, v, v + B, v + stride, v + stride + B, w00[col], w01[col], w10[col], w11[col], Wq,
-                        L_all.data() + col * B);
-        }
+      // (The bin count as a compile-time constant where it is the default:
+      // each look-up's pass over 32 bins is two AVX-512 iterations, and
+      // straight-line code without the loop's remainder handling.)
+      const auto suns = [&](auto bins) __attribute__((always_inline)) {
+        for (std::size_t col = 0; col < M; ++col)
+          if (u_T[col] >= 0.0) {
+            const float* v = transmittance.node_values(rc[q], static_cast<std::size_t>(node[col]));
+            weighted_add4(bins, v, v + B, v + stride, v + stride + B, w00[col], w01[col], w10[col], w11[col], Wq,
+                          L_all.data() + col * B);
+          }
+      };
+      if (B == kDefaultBins)
+        suns(std::integral_constant<std::size_t, kDefaultBins>{});
+      else
+        suns(B);
     }
     for (std::size_t col = 0; col < M; ++col) {
       std::copy(L_all.begin() + static_cast<std::ptrdiff_t>(col * B),

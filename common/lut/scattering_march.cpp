@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "common/core/constants.h"
 #include "common/lut/ground_irradiance_lut.h"
@@ -15,6 +16,8 @@ namespace {
 
 // Views per tile in add_inscattering.
 constexpr std::size_t kViewTile = 32;
+// The bin count the per-view loops are specialised for (LutResolution's default).
+constexpr std::size_t kDefaultBins = 32;
 
 // The sums over the steps are in single precision, like the tables they
 // read (bilinear.h): a step's weights, the views' phase values and their
@@ -43,7 +46,8 @@ inline void add_source(std::size_t B, float* __restrict L, const float* w0, cons
 
 // The same with T and Psi linear between two of the rows that radius_rows
 // and altitude_rows built for the step: t, t + B and m, m + B.
-inline void add_source_rows(std::size_t B, float* __restrict L, const float* w0, const float* p0, const float* w1,
+template <class Size>
+[[gnu::always_inline]] inline void add_source_rows(Size B, float* __restrict L, const float* w0, const float* p0, const float* w1,
                             const float* p1, float c1, const float* t, float ft, const float* m, float fm,
                             const float* w_ms) {
   const float gt = 1.0f - ft, gm = 1.0f - fm;
@@ -56,7 +60,8 @@ inline void add_source_rows(std::size_t B, float* __restrict L, const float* w0,
 
 // L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
 // whose point the planet hides from the sun.
-inline void add_weighted_row(std::size_t B, float* __restrict L, const float* m, float f, const float* w) {
+template <class Size>
+[[gnu::always_inline]] inline void add_weighted_row(Size B, float* __restrict L, const float* m, float f, const float* w) {
   const float g = 1.0f - f;
   for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
 }
@@ -245,16 +250,25 @@ void ScatteringMarch::add_step(std::size_t k, std::size_t n, const double* nu, c
       if (t_rows > 0) transmittance_.radius_rows(rc, static_cast<std::size_t>(t_lo), t_rows, T_rows);
       ms_->altitude_rows(ms_altitude_[k], static_cast<std::size_t>(m_lo), m_rows, M_rows);
       const std::size_t p1 = C == 2 ? B : 0;
-      for (std::size_t i = 0; i < n; ++i) {
-        const float* M = M_rows + static_cast<std::size_t>(jm[i] - m_lo) * B;
-        if (u_T[i] >= 0.0) {
-          const float* p = phase + i * C * B;
-          add_source_rows(B, L + i * B, wc, p, wc1, p + p1, c1, T_rows + static_cast<std::size_t>(jt[i] - t_lo) * B,
-                          ft[i], M, fm[i], wms);
-        } else {
-          add_weighted_row(B, L + i * B, M, fm[i], wms);
+      // Each view's pass over the bins is short (32 bins: two AVX-512
+      // iterations), so with the count known at compile time the loop is
+      // straight-line code without its remainder handling.
+      const auto views = [&](auto bins) __attribute__((always_inline)) {
+        for (std::size_t i = 0; i < n; ++i) {
+          const float* M = M_rows + static_cast<std::size_t>(jm[i] - m_lo) * B;
+          if (u_T[i] >= 0.0) {
+            const float* p = phase + i * C * B;
+            add_source_rows(bins, L + i * B, wc, p, wc1, p + p1, c1,
+                            T_rows + static_cast<std::size_t>(jt[i] - t_lo) * B, ft[i], M, fm[i], wms);
+          } else {
+            add_weighted_row(bins, L + i * B, M, fm[i], wms);
+          }
         }
-      }
+      };
+      if (B == kDefaultBins)
+        views(std::integral_constant<std::size_t, kDefaultBins>{});
+      else
+        views(B);
       return;
     }
     for (std::size_t i = 0; i < n; ++i) {
