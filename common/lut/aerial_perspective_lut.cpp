@@ -27,8 +27,8 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
   a.mapping_ = lut::ViewMapping(r, R, zenith_rows, azimuth_columns);
   const std::size_t B = static_cast<std::size_t>(a.bins_), cols = static_cast<std::size_t>(azimuth_columns);
   const std::size_t rows = static_cast<std::size_t>(a.mapping_.rows()), N = static_cast<std::size_t>(slices);
-  a.L_.assign(N * rows * cols * B, 0.0f);
-  a.T_.assign(N * rows * B, 0.0f);
+  a.L_.resize(N * rows * cols * B);  // every slice written below (slice 0: zeros)
+  a.T_.resize(N * rows * B);
   a.end_.assign(rows, 0.0);
   const double sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
 
@@ -52,7 +52,11 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
       medium.phase(nu[col], phase.data() + col * CB);
     }
     std::fill(L.begin(), L.end(), 0.0);
-    for (std::size_t k = 1; k < N; ++k) {  // slice 0 (d = 0) stays 0
+    for (std::size_t col = 0; col < cols; ++col) {  // slice 0 (d = 0): no light in-scattered yet
+      float* out = a.L_.data() + (row * cols + col) * N * B;
+      std::fill(out, out + B, 0.0f);
+    }
+    for (std::size_t k = 1; k < N; ++k) {
       march.add_inscattering(static_cast<int>(cols), nu.data(), phase.data(), mu_s, static_cast<int>(k - 1),
                              static_cast<int>(k), L.data());
       for (std::size_t col = 0; col < cols; ++col) {

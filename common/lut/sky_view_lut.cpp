@@ -23,7 +23,7 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
   const double r = std::clamp(observer_radius_m, R, R_top);
   s.mapping_ = lut::ViewMapping(r, R, zenith_rows, azimuth_columns);
   const std::size_t B = static_cast<std::size_t>(s.bins_), cols = static_cast<std::size_t>(azimuth_columns);
-  s.values_.assign(static_cast<std::size_t>(s.mapping_.rows()) * cols * B, 0.0f);
+  s.values_.resize(static_cast<std::size_t>(s.mapping_.rows()) * cols * B);  // every row written below
   const double sin_s = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
 
   ScatteringMarch march(medium, transmittance, &multiple_scattering, &ground);
