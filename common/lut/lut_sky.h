@@ -68,9 +68,10 @@
 // pages: page faults cost ~11 us each on this VM); the sun-dependent tables alone (with_sun) 6 /
 // 7.4 ms for an observer on the ground; one radiance look-up 84 / 107-139
 // ns; memory 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).
-// On a slower 2.3 GHz Xeon VM, all tables at 32 bins 40.2 ms at best (53.5
+// On a noisier 2.3 GHz Xeon VM, all tables at 32 bins 30.2 ms at best (39.0
 // in the same runs before single precision where the tables are stored,
-// compile-time bin counts in the per-view passes and reused table memory).  Where the time goes and what bounds it: docs/physics.md "The
+// compile-time bin counts in the per-view passes, no zero-fill of tables
+// written in full and reused table memory).  Where the time goes and what bounds it: docs/physics.md "The
 // LUT sky's build time".  A timelapse or a cache of many suns should build once and
 // call with_sun.
 #pragma once
