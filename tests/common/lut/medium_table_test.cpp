@@ -74,8 +74,12 @@ TEST(LutMediumTable, ExtinctionTermsAddUpToSigmaT) {
   EXPECT_EQ(m.padded_terms() % 8, 0);
   const std::size_t K = static_cast<std::size_t>(m.padded_terms()), B = 32;
   std::vector<double> s_t(B);
+  const std::size_t last_cell = static_cast<std::size_t>(m.altitude_samples() - 2);
   for (int i = 0; i < m.altitude_samples(); ++i) {
-    m.sigma_t(MediumTable::Node{static_cast<std::size_t>(i), 0.0}, s_t.data());
+    // Node i itself, as MediumTable::locate gives it: the last node is the
+    // end of the last cell (a Node past it would read beyond the table).
+    const std::size_t n = static_cast<std::size_t>(i);
+    m.sigma_t(n <= last_cell ? MediumTable::Node{n, 0.0} : MediumTable::Node{last_cell, 1.0}, s_t.data());
     for (std::size_t b = 0; b < B; ++b) {
       double sum = 0.0;
       for (std::size_t k = 0; k < K; ++k)
