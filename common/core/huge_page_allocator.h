@@ -23,8 +23,9 @@
 // the same tables again for every new sun or atmosphere); beyond that they
 // are unmapped.  A reused block is already faulted in, and the kernel does
 // not zero it again (zeroing fresh 2 MiB pages was ~5 % of a LUT build).
-// Its old contents are not cleared: the containers value-initialise their
-// elements as usual.  recycled_bytes() says how much is kept.
+// Its old contents are not cleared, and elements constructed without a
+// value are left unset (construct, below): a table that is not written in
+// full must assign its values.  recycled_bytes() says how much is kept.
 #pragma once
 #include <cstddef>
 #include <new>

@@ -71,9 +71,9 @@
 // On a noisier 2.3 GHz Xeon VM, all tables at 32 bins 30.2 ms at best (39.0
 // in the same runs before single precision where the tables are stored,
 // compile-time bin counts in the per-view passes, no zero-fill of tables
-// written in full and reused table memory).  Where the time goes and what bounds it: docs/physics.md "The
-// LUT sky's build time".  A timelapse or a cache of many suns should build once and
-// call with_sun.
+// written in full and reused table memory).  Where the time goes and what
+// bounds it: docs/physics.md "The LUT sky's build time".  A timelapse or a
+// cache of many suns should build once and call with_sun.
 #pragma once
 #include <atomic>
 #include <cstddef>

@@ -22,8 +22,9 @@ constexpr double kGoldenRatio = 1.6180339887498949;  // (1 + sqrt 5) / 2
 // acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
 // look-up with its weights given (lut::BilinearF::weighted_add).
 template <class Size>
-[[gnu::always_inline]] inline void weighted_add4(Size B, const float* v00, const float* v01, const float* v10, const float* v11,
-                          float w00, float w01, float w10, float w11, const float* weight, float* __restrict acc) {
+[[gnu::always_inline]] inline void weighted_add4(Size B, const float* v00, const float* v01, const float* v10,
+                                                 const float* v11, float w00, float w01, float w10, float w11,
+                                                 const float* weight, float* __restrict acc) {
   for (std::size_t b = 0; b < B; ++b)
     acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
 }

@@ -47,9 +47,9 @@ inline void add_source(std::size_t B, float* __restrict L, const float* w0, cons
 // The same with T and Psi linear between two of the rows that radius_rows
 // and altitude_rows built for the step: t, t + B and m, m + B.
 template <class Size>
-[[gnu::always_inline]] inline void add_source_rows(Size B, float* __restrict L, const float* w0, const float* p0, const float* w1,
-                            const float* p1, float c1, const float* t, float ft, const float* m, float fm,
-                            const float* w_ms) {
+[[gnu::always_inline]] inline void add_source_rows(Size B, float* __restrict L, const float* w0, const float* p0,
+                                                   const float* w1, const float* p1, float c1, const float* t,
+                                                   float ft, const float* m, float fm, const float* w_ms) {
   const float gt = 1.0f - ft, gm = 1.0f - fm;
   for (std::size_t b = 0; b < B; ++b) {
     const float T_sun = gt * t[b] + ft * t[B + b];
@@ -61,7 +61,8 @@ template <class Size>
 // L[b] += w[b] (row m and m + B, linear): the multiple scattering of a view
 // whose point the planet hides from the sun.
 template <class Size>
-[[gnu::always_inline]] inline void add_weighted_row(Size B, float* __restrict L, const float* m, float f, const float* w) {
+[[gnu::always_inline]] inline void add_weighted_row(Size B, float* __restrict L, const float* m, float f,
+                                                    const float* w) {
   const float g = 1.0f - f;
   for (std::size_t b = 0; b < B; ++b) L[b] += w[b] * (g * m[b] + f * m[B + b]);
 }

@@ -169,7 +169,8 @@ TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_sampl
   t.R_top_ = medium.top_radius_m();
   t.H_ = std::sqrt((t.R_top_ - t.R_) * (t.R_top_ + t.R_));
   const std::size_t B = static_cast<std::size_t>(t.bins_);
-  t.values_.resize(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B);  // all written below
+  // Every value is written below: resize, not assign (huge_page_allocator.h).
+  t.values_.resize(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B);
   OpticalDepthQuadrature quadrature(medium, t.steps_);
   std::vector<double> terms(static_cast<std::size_t>(medium.padded_terms())), tau(B);
   std::vector<double> r(static_cast<std::size_t>(mu_samples)), mu(static_cast<std::size_t>(mu_samples));
