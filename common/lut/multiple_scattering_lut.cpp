@@ -89,6 +89,8 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   std::vector<TransmittanceLut::RadiusCoord> rc(N * S);
   std::vector<double> a(N * S), bcoef(N * S), a_g(N), b_g(N), w_dir(N), t_mid(S), dt(S);
   std::vector<char> hits(N);
+  std::vector<double> r_step(S);
+  std::vector<MediumTable::Node> medium_node(S);
   const std::size_t M = static_cast<std::size_t>(mu_s_samples);
   std::vector<double> mu_s(M), sin_s(M), u_T(M);
   std::vector<float> L_all(M * B), w00(M), w01(M), w10(M), w11(M);
@@ -111,9 +113,16 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
       // them in double.)
       std::fill(T_acc.begin(), T_acc.end(), 1.0f);
       const float w_ring = static_cast<float>(w_dir[i]);
+      // The steps' coefficient rows are fetched ahead: in march order each
+      // step's rows are new and the table (2 MB) is not in the L2 cache.
       for (std::size_t k = 0; k < S; ++k) {
-        const double rk = lut::radius_at(r, mu, t_mid[k]);
-        const MediumTable::Node node = medium.locate(rk - R);
+        r_step[k] = lut::radius_at(r, mu, t_mid[k]);
+        medium_node[k] = medium.locate(r_step[k] - R);
+        medium.prefetch_sigma(medium_node[k]);
+      }
+      for (std::size_t k = 0; k < S; ++k) {
+        const double rk = r_step[k];
+        const MediumTable::Node node = medium_node[k];
         medium.sigma_t(node, s_t.data());
         medium.sigma_s(node, s_s.data());
         float* Wk = W.data() + (i * S + k) * B;
