@@ -43,6 +43,10 @@ class OpticalDepthQuadrature {
     }
   }
 
+  // The terms of every horizontal ray from the medium's altitude nodes to the
+  // top (TangentTable, below), for the second part of descending rays.
+  void use_tangent_table(const std::vector<double>* tangent) { tangent_ = tangent; }
+
   // terms[k] = int rho_k ds from radius r along mu to the top (rays into the
   // ground as if the planet were absent), k < medium.padded_terms().
   [[gnu::always_inline]] void terms_to_top(double r, double mu, double* terms) {
@@ -53,10 +57,14 @@ class OpticalDepthQuadrature {
     const double s0 = r * mu;
     const double s_top = std::sqrt(std::max(0.0, (R_top - l) * (R_top + l)));
     // A ray that descends to the closest approach first has two ascending
-    // parts in |s|.  (One call site in a loop: with a = 0 as a constant, GCC
-    // specialises add_part and leaves that copy's loop scalar.)
-    const double from[2] = {std::max(s0, 0.0), 0.0}, to[2] = {s0 < 0.0 ? -s0 : s_top, s_top};
-    for (int part = 0; part < (s0 < 0.0 ? 2 : 1); ++part) add_part(l, from[part], to[part], terms);
+    // parts in |s|; the second is the horizontal ray from the closest
+    // approach, from the tangent table when there is one.  (One call site in
+    // a loop: with a = 0 as a constant, GCC specialises add_part and leaves
+    // that copy's loop scalar.)
+    const bool descends = s0 < 0.0;
+    const double from[2] = {std::max(s0, 0.0), 0.0}, to[2] = {descends ? -s0 : s_top, s_top};
+    for (int part = 0; part < (descends && !tangent_ ? 2 : 1); ++part) add_part(l, from[part], to[part], terms);
+    if (descends && tangent_) add_tangent(l, terms);
   }
 
   // tau[b] from the terms.
@@ -73,6 +81,15 @@ class OpticalDepthQuadrature {
   }
 
  private:
+  // terms += the tangent table at closest approach l, linear in altitude.
+  [[gnu::always_inline]] void add_tangent(double l, double* terms) const {
+    const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
+    const MediumTable::Node node = medium_.locate(l - medium_.planet_radius_m());
+    const double* a = tangent_->data() + node.i * K;
+    const double f = node.f, g = 1.0 - f;
+    for (std::size_t k = 0; k < K; ++k) terms[k] += g * a[k] + f * a[K + k];
+  }
+
   // One part at distances [a, b] past the closest approach (radius l): the
   // samples' altitude nodes and weights in one vectorisable pass, then the
   // terms' profiles interpolated and summed.
@@ -162,12 +179,39 @@ class OpticalDepthQuadrature {
   }
 
   const MediumTable& medium_;
+  const std::vector<double>* tangent_ = nullptr;
   int n_;
   std::vector<float> u2_, frac_;
   std::vector<double> weight_;
   std::vector<int> node_;
   std::vector<double> w0_, w1_;
 };
+
+// The tangent table: per altitude node of the medium (h_i = i dh), the terms
+// of the horizontal ray from R + h_i to the top, by the quadrature on
+// 2 steps intervals, [node][padded term].  A ray that descends from r along
+// mu < 0 to its closest approach l and climbs to the top has the optical
+// depth of [l, r] plus this ray's at l, so the table replaces the second of
+// its two parts (0.78 of the Earth table's nodes have one, 44 % of the
+// samples) by a linear interpolation in altitude.  Measured on every
+// descending node of the Earth's table (32 bins) against a 2048-interval
+// quadrature, worst error as a fraction of the tolerance max(0.5 % T, 1e-4)
+// (and with 1e-5, 1e-6 in place of 1e-4): 0.61 (1.15, 1.28) with both parts
+// on 64 intervals; 0.30 (0.68, 0.77) with the table at the medium's 2048
+// nodes and 128 intervals; 0.64 (1.15, 1.29) at 64 intervals; 0.77 (1.14,
+// 1.36) at 1024 nodes; Catmull-Rom in place of linear interpolation is worse
+// (0.55, 2.4, 3.0): the medium's profiles are piecewise linear.
+SKYFARM_LUT_SIMD_CLONES
+std::vector<double> tangent_table(const MediumTable& medium, int steps) {
+  OpticalDepthQuadrature quadrature(medium, 2 * steps);
+  const std::size_t K = static_cast<std::size_t>(medium.padded_terms());
+  const std::size_t nodes = static_cast<std::size_t>(medium.altitude_samples());
+  std::vector<double> table(nodes * K);
+  for (std::size_t i = 0; i < nodes; ++i)
+    quadrature.terms_to_top(medium.planet_radius_m() + static_cast<double>(i) * medium.altitude_step_m(), 0.0,
+                            table.data() + i * K);
+  return table;
+}
 
 // One row of the table (radius node j): every mu node's transmittance.
 SKYFARM_LUT_SIMD_CLONES
@@ -207,7 +251,9 @@ TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_sampl
   const std::size_t B = static_cast<std::size_t>(t.bins_);
   // Every value is written below: resize, not assign (huge_page_allocator.h).
   t.values_.resize(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B);
+  const std::vector<double> tangent = tangent_table(medium, t.steps_);
   OpticalDepthQuadrature quadrature(medium, t.steps_);
+  quadrature.use_tangent_table(&tangent);
   std::vector<double> terms(static_cast<std::size_t>(medium.padded_terms())), tau(B);
   std::vector<double> r(static_cast<std::size_t>(mu_samples)), mu(static_cast<std::size_t>(mu_samples));
   for (int j = 0; j < r_samples; ++j) {

@@ -35,6 +35,11 @@
 // optical depth int sigma_t ds is summed by Simpson's rule in u, for each of
 // the medium's extinction terms (medium_table.h: 7 profiles for the Earth,
 // whatever the number of bins), then expanded to the bins once per node.
+// A ray that first descends has two parts, and its second (from the closest
+// approach to the top) is the horizontal ray from there: it comes from a
+// table of those rays' terms at the medium's altitude nodes (quadrature on
+// 2 x steps intervals), interpolated linearly (transmittance_lut.cpp,
+// tangent_table: half the samples of a build, and a smaller error).
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -118,9 +123,10 @@ class TransmittanceLut {
   void unit_from_r_mu(double r, double mu, double* x_r, double* x_mu) const;
   void r_mu_from_unit(double x_r, double x_mu, double* r, double* mu) const;
 
-  // Optical depth per bin from (r, mu) to the top by the quadrature above
-  // (what the table stores, as exp(-tau)); rays into the ground are
-  // integrated as if the planet were absent.
+  // Optical depth per bin from (r, mu) to the top by the quadrature above,
+  // every part on `steps` intervals (the table stores exp(-tau) of the same,
+  // with a descending ray's second part from the tangent table); rays into
+  // the ground are integrated as if the planet were absent.
   static void optical_depth_to_top(const MediumTable& medium, double r, double mu, int steps, double* tau);
 
   int mu_samples() const { return n_mu_; }
