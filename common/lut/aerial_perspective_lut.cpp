@@ -34,7 +34,8 @@ AerialPerspectiveLut AerialPerspectiveLut::build(const MediumTable& medium, cons
 
   ScatteringMarch march(medium, transmittance, &multiple_scattering, nullptr);
   const std::size_t CB = static_cast<std::size_t>(medium.scatterers()) * B;
-  std::vector<double> nu(cols), phase(cols * CB), boundaries(N), L(cols * B);
+  std::vector<float> phase(cols * CB);  // single precision, as the march uses it
+  std::vector<double> nu(cols), boundaries(N), L(cols * B);
   for (std::size_t row = 0; row < rows; ++row) {
     bool hits_ground;
     const double theta = a.mapping_.zenith_of_row(static_cast<int>(row), &hits_ground);

@@ -28,7 +28,8 @@ GroundIrradianceLut GroundIrradianceLut::build(const MediumTable& medium, const 
   const std::size_t M = static_cast<std::size_t>(mu_s_samples), V = kAzimuths * M;  // views per ring
   const std::size_t CB = static_cast<std::size_t>(medium.scatterers()) * B;
   std::vector<double> mu_s(M), sin_s(M), cos_phi(kAzimuths), w_phi(kAzimuths);
-  std::vector<double> nu(V), mu_s_view(V), phase(V * CB), L(V * B);
+  std::vector<double> nu(V), mu_s_view(V), L(V * B);
+  std::vector<float> phase(V * CB);  // single precision, as the march uses it
   for (std::size_t k = 0; k < M; ++k) {
     mu_s[k] = -1.0 + 2.0 * static_cast<double>(k) / static_cast<double>(M - 1);
     sin_s[k] = std::sqrt(std::max(0.0, 1.0 - mu_s[k] * mu_s[k]));

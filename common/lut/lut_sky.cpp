@@ -196,15 +196,22 @@ void LutSky::march(const glm::dvec3& origin, const glm::dvec3& d, double t_max, 
   const double t_end = std::min(t_exit, t_max);
   ScatteringMarch m(t.medium, t.transmittance, &t.multiple_scattering, &t.ground_irradiance);
   m.prepare(r0, mu, t_end, ground && hits && t_exit <= t_max, std::max(1, steps));
+  const std::size_t CB = static_cast<std::size_t>(t.medium.scatterers() * B);
   std::array<double, kMaxBins * 4> phase;  // scatterers x bins
+  std::array<float, kMaxBins * 4> phase_f;
   std::vector<double> phase_heap;
+  std::vector<float> phase_f_heap;
   double* P = phase.data();
-  if (static_cast<std::size_t>(t.medium.scatterers() * B) > phase.size()) {
-    phase_heap.resize(static_cast<std::size_t>(t.medium.scatterers() * B));
+  float* P_f = phase_f.data();
+  if (CB > phase.size()) {
+    phase_heap.resize(CB);
+    phase_f_heap.resize(CB);
     P = phase_heap.data();
+    P_f = phase_f_heap.data();
   }
   t.medium.phase_exact(nu, P);
-  m.add_inscattering(P, nu, mu_s0, 0, m.steps(), L);
+  std::copy(P, P + CB, P_f);  // (to float, as the march uses it)
+  m.add_inscattering(P_f, nu, mu_s0, 0, m.steps(), L);
   m.add_ground(nu, mu_s0, L);
   for (int b = 0; b < B; ++b) {
     L[b] *= sun_E_[static_cast<std::size_t>(b)];

@@ -200,6 +200,17 @@ void MediumTable::phase(double nu, double* out) const {
               scatterers_ * bins_, out);
 }
 
+void MediumTable::phase(double nu, float* out) const {
+  const double x = std::sqrt(std::clamp(0.5 * (1.0 - nu), 0.0, 1.0));
+  const double u = x * (phase_samples_ - 1);
+  const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(phase_samples_ - 2));
+  const std::size_t width = static_cast<std::size_t>(scatterers_ * bins_);
+  const double* a = phase_table_.data() + i * width;
+  const double* b = a + width;
+  const double f = u - static_cast<double>(i);
+  for (std::size_t k = 0; k < width; ++k) out[k] = static_cast<float>(a[k] + f * (b[k] - a[k]));
+}
+
 void MediumTable::phase_exact(double nu, double* out) const {
   for (std::size_t j = 0; j < phase_functions_.size(); ++j) out[j] = phase_functions_[j].eval(nu);
 }

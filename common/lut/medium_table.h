@@ -93,6 +93,8 @@ class MediumTable {
 
   // p_c,b(nu) for all scatterers and bins, out[c * bins + b], from the table.
   void phase(double nu, double* out) const;
+  // The same rounded to single precision, as the marches use it.
+  void phase(double nu, float* out) const;
   // The same, evaluated exactly (the reference march).
   void phase_exact(double nu, double* out) const;
 

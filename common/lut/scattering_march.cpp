@@ -102,7 +102,6 @@ ScatteringMarch::ScatteringMarch(const MediumTable& medium, const TransmittanceL
   tmp_.resize(B);
   u_T_.resize(kViewTile);
   u_ms_.resize(kViewTile);
-  phase_f_.resize(kViewTile * C * B);
   node_T_.resize(kViewTile);
   node_ms_.resize(kViewTile);
   frac_T_.resize(kViewTile);
@@ -171,7 +170,7 @@ void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
   }
 }
 
-void ScatteringMarch::add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1,
+void ScatteringMarch::add_inscattering(int n, const double* nu, const float* phase, double mu_s0, int k0, int k1,
                                        double* L) const {
   if (mu0_.size() < static_cast<std::size_t>(std::max(0, n))) mu0_.resize(static_cast<std::size_t>(n));
   std::fill(mu0_.begin(), mu0_.begin() + std::max(0, n), mu_s0);
@@ -180,20 +179,19 @@ void ScatteringMarch::add_inscattering(int n, const double* nu, const double* ph
 
 // Views in tiles of kViewTile, all steps per tile: a tile's phase values,
 // sums and the table rows its views read stay in the L1 cache.
-void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0,
+void ScatteringMarch::add_inscattering(int n, const double* nu, const double* mu_s0, const float* phase, int k0,
                                        int k1, double* L) const {
   const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
   const std::size_t N = static_cast<std::size_t>(std::max(0, n));
   for (std::size_t first = 0; first < N; first += kViewTile) {
     const std::size_t m = std::min(kViewTile, N - first);
-    std::copy(phase + first * C * B, phase + (first + m) * C * B, phase_f_.begin());
     std::fill(L_f_.begin(), L_f_.begin() + static_cast<std::ptrdiff_t>(m * B), 0.0f);
     // A step of zero length adds exactly 0 (its weights are 0): skipped.  All
     // steps of a ray that starts on the ground and goes down are (the sky-
     // view table's ground rows for an observer at 0 m: half its rows).
     for (int k = std::max(0, k0); k < std::min(k1, steps_); ++k)
       if (dt_[static_cast<std::size_t>(k)] > 0.0)
-        add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase_f_.data(), L_f_.data());
+        add_step(static_cast<std::size_t>(k), m, nu + first, mu_s0 + first, phase + first * C * B, L_f_.data());
     double* out = L + first * B;
     for (std::size_t j = 0; j < m * B; ++j) out[j] += L_f_[j];
   }

@@ -59,18 +59,19 @@ class ScatteringMarch {
 
   // L[b] += in-scattered radiance of steps [k0, k1) per unit E_sun, for a sun
   // at zenith cosine mu_s0 seen from x_0 and nu = v . s; phase[c * bins + b]
-  // = p_c,b(nu) (MediumTable::phase or phase_exact).
-  void add_inscattering(const double* phase, double nu, double mu_s0, int k0, int k1, double* L) const {
+  // = p_c,b(nu) (MediumTable::phase or phase_exact) in single precision, as
+  // the tables it multiplies (bilinear.h).
+  void add_inscattering(const float* phase, double nu, double mu_s0, int k0, int k1, double* L) const {
     add_inscattering(1, &nu, phase, mu_s0, k0, k1, L);
   }
   // The same for n views that share this ray's altitude profile but not its
   // azimuth (a table row's columns): nu[i], phase + i * scatterers * bins,
   // L + i * bins.  The look-up positions of all n views are computed in one
   // vectorisable pass per step.
-  void add_inscattering(int n, const double* nu, const double* phase, double mu_s0, int k0, int k1, double* L) const;
+  void add_inscattering(int n, const double* nu, const float* phase, double mu_s0, int k0, int k1, double* L) const;
   // The same with a sun per view: mu_s0[i] (the ground-irradiance table's
   // suns, one per view).
-  void add_inscattering(int n, const double* nu, const double* mu_s0, const double* phase, int k0, int k1,
+  void add_inscattering(int n, const double* nu, const double* mu_s0, const float* phase, int k0, int k1,
                         double* L) const;
   // L[b] += the ground's reflected radiance times T(x_0, x_g), if the ray ends on it.
   void add_ground(double nu, double mu_s0, double* L) const;
@@ -98,7 +99,7 @@ class ScatteringMarch {
   std::vector<double> s_t_, s_s_, s_c_;  // scratch per step
   // Scratch of the look-ups (a ScatteringMarch is used by one thread at a time).
   mutable std::vector<double> tmp_, u_T_, u_ms_, mu0_;
-  mutable std::vector<float> w_phase_, phase_f_, L_f_, rows_T_, rows_M_, frac_T_, frac_ms_;
+  mutable std::vector<float> w_phase_, L_f_, rows_T_, rows_M_, frac_T_, frac_ms_;
   mutable std::vector<int> node_T_, node_ms_;
 };
 

@@ -28,7 +28,8 @@ SkyViewLut SkyViewLut::build(const MediumTable& medium, const TransmittanceLut& 
 
   ScatteringMarch march(medium, transmittance, &multiple_scattering, &ground);
   const std::size_t CB = static_cast<std::size_t>(medium.scatterers()) * B;
-  std::vector<double> nu(cols), phase(cols * CB), L(cols * B);
+  std::vector<float> phase(cols * CB);  // single precision, as the march uses it
+  std::vector<double> nu(cols), L(cols * B);
   for (int row = 0; row < s.mapping_.rows(); ++row) {
     bool hits_ground;
     const double theta = s.mapping_.zenith_of_row(row, &hits_ground);

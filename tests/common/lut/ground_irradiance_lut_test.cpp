@@ -28,7 +28,8 @@ std::vector<double> dense_rule(const MediumTable& medium, const TransmittanceLut
   const std::size_t CB = static_cast<std::size_t>(medium.scatterers()) * B, V = static_cast<std::size_t>(n_phi) * M;
   const double R = medium.planet_radius_m(), R_top = medium.top_radius_m();
   ScatteringMarch march(medium, T, &ms, nullptr);
-  std::vector<double> I(M * B, 0.0), nu(V), mu_s(V), phase(V * CB), L(V * B);
+  std::vector<double> I(M * B, 0.0), nu(V), mu_s(V), L(V * B);
+  std::vector<float> phase(V * CB);
   for (int i = 0; i < n_mu; ++i) {
     const double mu = (i + 0.5) / n_mu, sin_theta = std::sqrt(1.0 - mu * mu);
     march.prepare(R, mu, lut::distance_to_top(R, mu, R_top), false, 20);
