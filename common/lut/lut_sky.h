@@ -12,7 +12,7 @@
 //                              part of a ray (transmittance_lut.h)
 //   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions (32 mirror-
 //                              paired rings), 20 steps
-//   ground_irradiance_*        32 mu_s, 64 directions, 20 steps
+//   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
 //   sky_view_*                 192 azimuths x 108 zenith rows, 30 steps
 //   aerial_*                   32 x 32 x 32 slices up to 64 km
 //   space_view_steps           march steps of a view from above the top (64)
@@ -99,7 +99,7 @@ struct LutResolution {
   int transmittance_mu = 256, transmittance_r = 128, transmittance_steps = 64;
   int multiple_scattering_mu_s = 32, multiple_scattering_altitude = 32;
   int multiple_scattering_directions = 64, multiple_scattering_steps = 20;
-  int ground_irradiance_mu_s = 32, ground_irradiance_directions = 64, ground_irradiance_steps = 20;
+  int ground_irradiance_mu_s = 64, ground_irradiance_directions = 64, ground_irradiance_steps = 20;
   int sky_view_azimuth = 192, sky_view_zenith = 108, sky_view_steps = 30;
   int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
   double aerial_max_distance_m = 64000.0;
