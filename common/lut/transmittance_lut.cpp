@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <span>
 #include <type_traits>
 #include <vector>
@@ -47,7 +48,7 @@ class OpticalDepthQuadrature {
   // top (tangent_table, below), for the second part of descending rays.
   // mirror: a descending ray's optical depth as 2 tau_h(l) - its mirror
   // image's (the ray from r along -mu, which climbs from r to the top on the
-  // same line), for rows whose rays from r are thin (fill_rows, below).
+  // same line), for rows whose rays from r are thin (climb_rule, below).
   void use_tangent_table(const std::vector<double>* tangent, bool mirror) {
     tangent_ = tangent;
     mirror_ = mirror;
@@ -79,11 +80,7 @@ class OpticalDepthQuadrature {
     if (mirror) {
       // 2 tau_h(l) - (r to the top), each term >= tau_h(l) >= 0 exactly; the
       // max guards the rounding of terms that vanish.
-      const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
-      const MediumTable::Node node = medium_.locate(l - R);
-      const double* a = tangent_->data() + node.i * K;
-      const double f = node.f, g = 1.0 - f;
-      for (std::size_t k = 0; k < K; ++k) terms[k] = std::max(0.0, 2.0 * (g * a[k] + f * a[K + k]) - terms[k]);
+      combine_tangent(l, terms, [](double climb, double tau_h) { return std::max(0.0, 2.0 * tau_h - climb); });
     } else if (descends && tangent_) {
       add_tangent(l, terms);
     }
@@ -103,13 +100,18 @@ class OpticalDepthQuadrature {
   }
 
  private:
-  // terms += the tangent table at closest approach l, linear in altitude.
-  [[gnu::always_inline]] void add_tangent(double l, double* terms) const {
+  // terms[k] = combine(terms[k], the tangent table at closest approach l,
+  // linear in altitude).
+  template <class Combine>
+  [[gnu::always_inline]] void combine_tangent(double l, double* terms, Combine combine) const {
     const std::size_t K = static_cast<std::size_t>(medium_.padded_terms());
     const MediumTable::Node node = medium_.locate(l - medium_.planet_radius_m());
     const double* a = tangent_->data() + node.i * K;
     const double f = node.f, g = 1.0 - f;
-    for (std::size_t k = 0; k < K; ++k) terms[k] += g * a[k] + f * a[K + k];
+    for (std::size_t k = 0; k < K; ++k) terms[k] = combine(terms[k], g * a[k] + f * a[K + k]);
+  }
+  [[gnu::always_inline]] void add_tangent(double l, double* terms) const {
+    combine_tangent(l, terms, [](double t, double tau_h) { return t + tau_h; });
   }
 
   // One part at distances [a, b] past the closest approach (radius l): the
@@ -257,22 +259,30 @@ void fill_row(OpticalDepthQuadrature& quadrature, std::span<const double> r, std
   }
 }
 
-}  // namespace
-
 // Intervals for the rays of one table row (radius r) that start at r and
 // climb: every upward node, and the mirror images of the descending ones.
-// Each of them is no thicker than the horizontal ray from r, whose optical
-// depth tau_h(r) the tangent table gives, so its largest bin bounds the
-// rays' optical depth, and thin rays need fewer intervals for the same
-// error.  Measured on the Earth's table (32 bins), per bound, the worst
-// error of such rays against a 2048-interval quadrature as a fraction of
-// max(0.5 % T, 1e-5): below 1/8, 0.28 at 8 intervals; below 1/4, 0.27 at 16;
-// below 1/2, 0.19 at 24; below 1, 0.23 at 32 (0.48 between 1 and 2, so
-// thicker rows keep `steps`).
-int climb_intervals(double tau_bound, int steps) {
-  const int n = tau_bound < 0.125 ? 8 : tau_bound < 0.25 ? 16 : tau_bound < 0.5 ? 24 : tau_bound < 1.0 ? 32 : steps;
-  return std::min(n, steps);
+// Each of them is no thicker than the horizontal ray from r (the path
+// length per altitude grows with the zenith angle), whose optical depth
+// tau_h(r) the tangent table gives, so its largest bin bounds the rays'
+// optical depth, and thin rays need fewer intervals for the same error.
+// Measured on the Earth's table (32 bins), per bound, the worst error of
+// such rays against a 2048-interval quadrature as a fraction of max(0.5 % T,
+// 1e-5): below 1/8, 0.28 at 8 intervals; below 1/4, 0.27 at 16; below 1/2,
+// 0.19 at 24; below 1, 0.23 at 32 (0.48 between 1 and 2, so thicker rows
+// keep `steps`).
+constexpr double kThinRowBound[] = {0.125, 0.25, 0.5, 1.0};
+constexpr int kThinRowIntervals[] = {8, 16, 24, 32};
+constexpr std::size_t kThinRules = std::size(kThinRowBound);
+
+// The rule for a row whose bound is tau_bound: an index into
+// kThinRowIntervals, or kThinRules for `steps` intervals.
+std::size_t climb_rule(double tau_bound) {
+  std::size_t rule = 0;
+  while (rule < kThinRules && !(tau_bound < kThinRowBound[rule])) ++rule;
+  return rule;
 }
+
+}  // namespace
 
 TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_samples, int r_samples, int steps) {
   if (mu_samples < 2 || r_samples < 2 || steps < 2)
@@ -290,10 +300,11 @@ TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_sampl
   // Every value is written below: resize, not assign (huge_page_allocator.h).
   t.values_.resize(static_cast<std::size_t>(mu_samples) * static_cast<std::size_t>(r_samples) * B);
   const std::vector<double> tangent = tangent_table(medium, t.steps_);
-  // One quadrature per interval count a row may use (climb_intervals).
+  // One quadrature per rule a row may use (climb_rule), the last on steps.
   std::vector<OpticalDepthQuadrature> quadratures;
-  for (const int n : {8, 16, 24, 32, t.steps_}) {
-    quadratures.emplace_back(medium, std::min(n, t.steps_));
+  for (std::size_t rule = 0; rule <= kThinRules; ++rule) {
+    const int n = rule < kThinRules ? std::min(kThinRowIntervals[rule], t.steps_) : t.steps_;
+    quadratures.emplace_back(medium, n);
     quadratures.back().use_tangent_table(&tangent, n < t.steps_);
   }
   std::vector<double> terms(static_cast<std::size_t>(medium.padded_terms())), tau(B);
@@ -305,9 +316,8 @@ TransmittanceLut TransmittanceLut::build(const MediumTable& medium, int mu_sampl
     // The row's bound: the horizontal ray from r, its thickest bin.
     quadratures.back().tangent_terms(r[0], terms.data());
     quadratures.back().expand(terms.data(), tau.data());
-    const int n = climb_intervals(*std::max_element(tau.begin(), tau.end()), t.steps_);
-    const std::size_t q = n == 8 ? 0 : n == 16 ? 1 : n == 24 ? 2 : n == 32 ? 3 : 4;
-    fill_row(quadratures[q], r, mu, t.bins_, terms.data(), tau.data(),
+    const std::size_t rule = climb_rule(*std::max_element(tau.begin(), tau.end()));
+    fill_row(quadratures[rule], r, mu, t.bins_, terms.data(), tau.data(),
              t.values_.data() + static_cast<std::size_t>(j) * mu.size() * B);
   }
   return t;
