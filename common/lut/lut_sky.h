@@ -71,7 +71,10 @@
 // On a noisier 2.3 GHz Xeon VM, all tables at 32 bins 30.2 ms at best (39.0
 // in the same runs before single precision where the tables are stored,
 // compile-time bin counts in the per-view passes, no zero-fill of tables
-// written in full and reused table memory).  Where the time goes and what
+// written in full and reused table memory).  On an AMD EPYC (Zen 5) VM,
+// 12.6 / 18.0 ms at best (19.8 ms median at 32 bins; 16.7 / 24.6 before the
+// transmittance table's tangent table and thin rows, prefetched coefficient
+// rows and single-precision phases), with_sun 5.5 ms.  Where the time goes and what
 // bounds it: docs/physics.md "The LUT sky's build time".  A timelapse or a
 // cache of many suns should build once and call with_sun.
 #pragma once

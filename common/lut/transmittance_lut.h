@@ -39,7 +39,10 @@
 // approach to the top) is the horizontal ray from there: it comes from a
 // table of those rays' terms at the medium's altitude nodes (quadrature on
 // 2 x steps intervals), interpolated linearly (transmittance_lut.cpp,
-// tangent_table: half the samples of a build, and a smaller error).
+// tangent_table: half the samples of a build, and a smaller error).  Rows
+// whose horizontal ray is thin (optical depth below 1 in every bin: above
+// ~30 km on the Earth) climb from r on 8-32 intervals, a descending ray
+// there as 2 tau_h(l) minus its mirror image's climb (climb_rule).
 #pragma once
 #include <algorithm>
 #include <cmath>
