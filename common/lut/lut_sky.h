@@ -96,7 +96,7 @@ class SkyViewLut;
 class AerialPerspectiveLut;
 
 struct LutResolution {
-  int spectral_bins = 32;
+  int spectral_bins = static_cast<int>(kDefaultLutBins);
   int medium_altitude_samples = 2048;
   int phase_samples = 512;
   int transmittance_mu = 256, transmittance_r = 128, transmittance_steps = 64;

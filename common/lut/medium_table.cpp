@@ -192,23 +192,22 @@ void MediumTable::build_phase(const Atmosphere& atmosphere, const SpectralGrid& 
 
 
 // Linear in x = sin(theta/2) = sqrt((1 - nu)/2) between the table's nodes.
-void MediumTable::phase(double nu, double* out) const {
+// Where nu falls on the phase table's nodes (x = sqrt((1 - nu) / 2)).
+MediumTable::Node MediumTable::phase_node(double nu) const {
   const double x = std::sqrt(std::clamp(0.5 * (1.0 - nu), 0.0, 1.0));
   const double u = x * (phase_samples_ - 1);
   const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(phase_samples_ - 2));
-  interpolate(phase_table_.data(), static_cast<std::size_t>(scatterers_ * bins_), Node{i, u - static_cast<double>(i)},
-              scatterers_ * bins_, out);
+  return Node{i, u - static_cast<double>(i)};
+}
+
+void MediumTable::phase(double nu, double* out) const {
+  interpolate(phase_table_.data(), static_cast<std::size_t>(scatterers_ * bins_), phase_node(nu), scatterers_ * bins_,
+              out);
 }
 
 void MediumTable::phase(double nu, float* out) const {
-  const double x = std::sqrt(std::clamp(0.5 * (1.0 - nu), 0.0, 1.0));
-  const double u = x * (phase_samples_ - 1);
-  const std::size_t i = std::min(static_cast<std::size_t>(u), static_cast<std::size_t>(phase_samples_ - 2));
-  const std::size_t width = static_cast<std::size_t>(scatterers_ * bins_);
-  const double* a = phase_table_.data() + i * width;
-  const double* b = a + width;
-  const double f = u - static_cast<double>(i);
-  for (std::size_t k = 0; k < width; ++k) out[k] = static_cast<float>(a[k] + f * (b[k] - a[k]));
+  interpolate(phase_table_.data(), static_cast<std::size_t>(scatterers_ * bins_), phase_node(nu), scatterers_ * bins_,
+              out);
 }
 
 void MediumTable::phase_exact(double nu, double* out) const {

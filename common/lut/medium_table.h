@@ -116,11 +116,14 @@ class MediumTable {
   std::size_t memory_bytes() const;
 
  private:
-  // out[k] = table row i + f (row i + 1 - row i), k < width; rows `stride` apart.
-  static void interpolate(const double* table, std::size_t stride, Node n, int width, double* out) {
+  Node phase_node(double nu) const;
+  // out[k] = table row i + f (row i + 1 - row i), k < width; rows `stride`
+  // apart (in double, then stored as Out).
+  template <class Out>
+  static void interpolate(const double* table, std::size_t stride, Node n, int width, Out* out) {
     const double* a = table + n.i * stride;
     const double* b = a + stride;
-    for (int k = 0; k < width; ++k) out[k] = a[k] + n.f * (b[k] - a[k]);
+    for (int k = 0; k < width; ++k) out[k] = static_cast<Out>(a[k] + n.f * (b[k] - a[k]));
   }
   // Values per altitude node in coefficients_: sigma_t, sigma_s, sigma_s per scatterer.
   std::size_t node_width() const { return static_cast<std::size_t>((2 + scatterers_) * bins_); }

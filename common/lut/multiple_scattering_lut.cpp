@@ -16,7 +16,7 @@ namespace skyfarm {
 
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
-constexpr std::size_t kDefaultBins = 32;  // LutResolution's default
+constexpr std::size_t kDefaultBins = kDefaultLutBins;
 constexpr double kGoldenRatio = 1.6180339887498949;  // (1 + sqrt 5) / 2
 
 // acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear

@@ -16,8 +16,8 @@ namespace {
 
 // Views per tile in add_inscattering.
 constexpr std::size_t kViewTile = 32;
-// The bin count the per-view loops are specialised for (LutResolution's default).
-constexpr std::size_t kDefaultBins = 32;
+// The bin count the per-view loops are specialised for.
+constexpr std::size_t kDefaultBins = kDefaultLutBins;
 
 // The sums over the steps are in single precision, like the tables they
 // read (bilinear.h): a step's weights, the views' phase values and their

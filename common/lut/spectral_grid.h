@@ -25,6 +25,7 @@
 // between their 1 nm knots and the reconstruction is linear between bin
 // centres, so Simpson's rule on the merged knots makes the weights exact.
 #pragma once
+#include <cstddef>
 #include <functional>
 #include <span>
 #include <vector>
@@ -32,6 +33,10 @@
 #include "common/spectrum/color.h"
 
 namespace skyfarm {
+
+// The LUT sky's default bin count (LutResolution::spectral_bins): the LUT
+// builders' passes over the bins are compiled for it as a constant too.
+inline constexpr std::size_t kDefaultLutBins = 32;
 
 class SpectralGrid {
  public:

@@ -20,7 +20,7 @@ namespace skyfarm {
 using lut::distance_to_top;
 
 namespace {
-constexpr int kDefaultBins = 32;  // LutResolution's default
+constexpr std::size_t kDefaultBins = kDefaultLutBins;
 
 // The nodes are equally spaced in v = 1 - (1 - x_mu)^(1/4) (mu_position, in
 // the header: two square roots, cheaper in the look-ups than a cube root).
@@ -88,7 +88,7 @@ class OpticalDepthQuadrature {
 
   // tau[b] from the terms.
   [[gnu::always_inline]] void expand(const double* terms, double* tau) const {
-    if (medium_.bins() == kDefaultBins) return expand_default(terms, tau);
+    if (static_cast<std::size_t>(medium_.bins()) == kDefaultBins) return expand_default(terms, tau);
     const std::size_t B = static_cast<std::size_t>(medium_.bins());
     const double* spectra = medium_.term_spectra();
     std::fill(tau, tau + B, 0.0);
