@@ -22,6 +22,7 @@ RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
                                      mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
+  plan.shadow_guide = !lut && shadow_guide_pays(sun.zenith_deg());
   plan.adaptive = !lut && request.quality.adaptive && plan.passes >= 2;
   // An observer on the ground sees one ground point in every downward
   // direction (common/film/ground_pool.h).

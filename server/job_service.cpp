@@ -88,7 +88,7 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
           {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
           {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control},
-          {"adaptive", plan.adaptive},
+          {"shadow_guide", plan.shadow_guide},     {"adaptive", plan.adaptive},
           {"pooled_ground_row", plan.pooled_ground_row >= 0 ? nlohmann::json(plan.pooled_ground_row) : nlohmann::json()}};
 }
 

@@ -7,6 +7,7 @@
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
 #include "common/render/radiance_control.h"
+#include "common/render/shadow_guide.h"
 #include "common/render/sun_pixels.h"
 #include "common/spectrum/color.h"
 
@@ -14,11 +15,13 @@ namespace skyfarm {
 
 namespace {
 
-// The caller's options, with the roulette control built when the plan asks
-// for one and the caller gave none.
-IntegratorOptions with_roulette_control(const Scene& scene, const RenderPlan& plan, IntegratorOptions options) {
+// The caller's options, with the roulette control and the shadow guide built
+// when the plan asks for them and the caller gave none.
+IntegratorOptions with_plan_tables(const Scene& scene, const RenderPlan& plan, IntegratorOptions options) {
   if (plan.roulette_control && !plan.lut && !options.roulette_control)
     options.roulette_control = std::make_shared<const RadianceControl>(scene);
+  if (plan.shadow_guide && !plan.lut && !options.shadow_guide)
+    options.shadow_guide = std::make_shared<const ShadowGuide>(scene);
   return options;
 }
 
@@ -26,7 +29,7 @@ IntegratorOptions with_roulette_control(const Scene& scene, const RenderPlan& pl
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
                            IntegratorOptions options)
-    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, with_roulette_control(scene, plan, options)),
+    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, with_plan_tables(scene, plan, options)),
       sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())) {
   if (plan_.lut)
     lut_ = std::make_shared<const LutSky>(LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),

@@ -1,6 +1,7 @@
 #include "common/render/volume_path_integrator.h"
 
 #include "common/render/radiance_control.h"
+#include "common/render/shadow_guide.h"
 
 #include <algorithm>
 #include <cmath>
@@ -290,6 +291,11 @@ bool VolumePathIntegrator::in_planet_shadow(const glm::dvec3& p) const {
   return ps < 0.0 && glm::dot(p, p) - ps * ps < R * R;
 }
 
+// The shadow guide where it applies at p (the sun below p's horizontal), or null.
+const ShadowGuide* VolumePathIntegrator::shadow_guide_at(const glm::dvec3& p) const {
+  return options_.shadow_guide && options_.shadow_guide->covers(p) ? options_.shadow_guide.get() : nullptr;
+}
+
 std::optional<glm::dvec3> VolumePathIntegrator::twilight_guide(const glm::dvec3& p) const {
   if (!(options_.twilight_guide_fraction > 0.0) || !scene_.sun_enabled) return std::nullopt;
   if (!in_planet_shadow(p)) return std::nullopt;
@@ -308,13 +314,20 @@ std::optional<glm::dvec3> VolumePathIntegrator::twilight_guide(const glm::dvec3&
 // mixture's (per wavelength, for the spectral MIS); false if it has none.
 bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPoint& mp, const PathPhases& phases,
                                              Sampler& sampler, Ray* ray, PathState* st) const {
-  const std::optional<glm::dvec3> guide = twilight_guide(p);
-  const double alpha = guide ? options_.twilight_guide_fraction : 0.0;
+  const ShadowGuide* table = shadow_guide_at(p);
+  const std::optional<glm::dvec3> guide = table ? std::nullopt : twilight_guide(p);
+  const double alpha = table ? options_.shadow_guide_fraction : guide ? options_.twilight_guide_fraction : 0.0;
   glm::dvec3 wi;
-  if (guide && sampler.next() < alpha) {
-    const glm::dvec3 local = square_to_von_mises_fisher({sampler.next(), sampler.next()}, kGuideKappa);
-    wi = glm::normalize(Frame(*guide).to_world(local));
-    sampler.next();  // as many numbers as the phase branch
+  if ((table || guide) && sampler.next() < alpha) {
+    if (table) {
+      double unused = 0.0;
+      const double u1 = sampler.next(), u2 = sampler.next(), u3 = sampler.next();
+      wi = table->sample(p, u1, u2, u3, &unused);
+    } else {
+      const glm::dvec3 local = square_to_von_mises_fisher({sampler.next(), sampler.next()}, kGuideKappa);
+      wi = glm::normalize(Frame(*guide).to_world(local));
+      sampler.next();  // as many numbers as the phase branch
+    }
   } else {
     double pick = sampler.next() * mp.sigma_s[0];
     int s = 0;
@@ -329,7 +342,9 @@ bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPo
   }
   const SampledSpectrum p_mix = mixture_phase(mp, phases, clamp_cos(glm::dot(ray->d, wi)));
   SampledSpectrum pdf = p_mix;  // per wavelength, had it been the hero
-  if (guide) {
+  if (table) {
+    pdf = p_mix * (1.0 - alpha) + SampledSpectrum(alpha * table->pdf(p, wi));
+  } else if (guide) {
     const double p_guide = square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa);
     pdf = p_mix * (1.0 - alpha) + SampledSpectrum(alpha * p_guide);
   }
@@ -473,7 +488,10 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
     pdf_scatter = f;
-    if (const std::optional<glm::dvec3> guide = twilight_guide(v.p)) {  // (penumbra: the disk partly seen)
+    if (const ShadowGuide* table = shadow_guide_at(v.p)) {
+      const double alpha = options_.shadow_guide_fraction;
+      pdf_scatter = f * (1.0 - alpha) + SampledSpectrum(alpha * table->pdf(v.p, wi));
+    } else if (const std::optional<glm::dvec3> guide = twilight_guide(v.p)) {  // (penumbra: the disk partly seen)
       const double alpha = options_.twilight_guide_fraction;
       pdf_scatter = f * (1.0 - alpha) + SampledSpectrum(
           alpha * square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa));

@@ -1,5 +1,6 @@
 // The scene plan a request compiles to (api/render_setup.h render_plan_for):
-// which renders get Russian roulette with the LUT sky as a control variate.
+// which renders get Russian roulette with the LUT sky as a control variate,
+// and which the shadow guide.
 #include <gtest/gtest.h>
 
 #include <string>
@@ -27,6 +28,16 @@ TEST(RenderPlanFor, RouletteControlOnlyForPathTracedSkiesWithAHighSun) {
   EXPECT_FALSE(plan_of(96.0).roulette_control);
   // The LUT renderer traces no paths.
   EXPECT_FALSE(plan_of(30.0, "lut").roulette_control);
+}
+
+// The shadow guide (shadow_guide.h) for path-traced skies with the sun
+// below the observer's horizon; at sunset it measured no gain.
+TEST(RenderPlanFor, ShadowGuideOnlyForPathTracedSkiesWithTheSunBelowTheHorizon) {
+  EXPECT_TRUE(plan_of(96.0).shadow_guide);
+  EXPECT_TRUE(plan_of(108.0).shadow_guide);
+  EXPECT_FALSE(plan_of(90.0).shadow_guide);
+  EXPECT_FALSE(plan_of(30.0).shadow_guide);
+  EXPECT_FALSE(plan_of(96.0, "lut").shadow_guide);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/radiance_control.h"
 #include "common/render/radiance_probe.h"
+#include "common/render/shadow_guide.h"
 #include "common/render/volume_path_integrator.h"
 
 namespace skyfarm {
@@ -230,6 +231,36 @@ TEST(IntegratorPhysics, TwilightGuideKeepsTheMean) {
     const double se = std::hypot(a.se[k], b.se[k]);
     EXPECT_NEAR(a.mean[k], b.mean[k], 4.0 * se) << lambdas[k] << " nm";
     EXPECT_LT(se / b.mean[k], 0.1) << lambdas[k] << " nm";
+  }
+}
+
+// --- The shadow guide (shadow_guide.h) draws part of the directions at
+// vertices where the sun is below the local horizontal from a table of the
+// light arriving there; the pdf is the mixture's, so the mean is unchanged:
+// up to third order, with and without it (and without the lobe it replaces),
+// towards the sun low and away from it high, within 4 combined standard
+// errors at four wavelengths.
+TEST(IntegratorPhysics, ShadowGuideKeepsTheMean) {
+  const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun_at(96.0, 0.0, 0.0), Location{}, std::nullopt, 400.0, 700.0);
+  const std::array<double, 4> lambdas = {430.0, 510.0, 590.0, 660.0};
+  IntegratorOptions guided, unguided;
+  guided.max_depth = unguided.max_depth = 3;
+  guided.shadow_guide = std::make_shared<const ShadowGuide>(scene);
+  unguided.twilight_guide_fraction = 0.0;
+  const VolumePathIntegrator a(scene, guided), b(scene, unguided);
+  int d = 0;
+  for (const glm::dvec2 zenith_azimuth : {glm::dvec2(80.0, 0.0), glm::dvec2(50.0, 180.0)}) {
+    const Ray ray{scene.observer(),
+                  direction_from_zenith_azimuth(zenith_azimuth.x * kDegToRad, zenith_azimuth.y * kDegToRad)};
+    const RotatedHeroMoments ma = radiance_with_rotated_hero(a, ray, lambdas, 40000, 61 + d);
+    const RotatedHeroMoments mb = radiance_with_rotated_hero(b, ray, lambdas, 40000, 71 + d);
+    ++d;
+    EXPECT_EQ(ma.counters.nonfinite + mb.counters.nonfinite, 0u);
+    for (std::size_t k = 0; k < 4; ++k) {
+      const double se = std::hypot(ma.se[k], mb.se[k]);
+      EXPECT_NEAR(ma.mean[k], mb.mean[k], 4.0 * se) << "zenith " << zenith_azimuth.x << ", " << lambdas[k] << " nm";
+      EXPECT_LT(se / mb.mean[k], 0.15) << "zenith " << zenith_azimuth.x << ", " << lambdas[k] << " nm";
+    }
   }
 }
 
