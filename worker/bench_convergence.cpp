@@ -84,6 +84,30 @@ double true_error(const std::vector<double>& Y, const std::vector<double>& ref, 
   return den > 0.0 ? std::sqrt(num / den) : 0.0;
 }
 
+// Where the true error is (--breakdown): each row's share of sum (Y - Y_ref)^2
+// and of sum Y_ref^2, and the pixel with the largest share (at twilight a
+// single path a thousand times the pixel's mean can be most of the error).
+void print_error_breakdown(const std::vector<double>& Y, const std::vector<double>& ref, const std::vector<bool>& keep) {
+  double num = 0.0, den = 0.0, worst = 0.0;
+  std::vector<double> row_num(32, 0.0), row_den(32, 0.0);
+  std::size_t worst_i = 0;
+  for (std::size_t i = 0; i < Y.size(); ++i) {
+    if (!keep[i]) continue;
+    const double d2 = (Y[i] - ref[i]) * (Y[i] - ref[i]);
+    num += d2;
+    den += ref[i] * ref[i];
+    row_num[i / 64] += d2;
+    row_den[i / 64] += ref[i] * ref[i];
+    if (d2 > worst) worst = d2, worst_i = i;
+  }
+  if (!(num > 0.0) || !(den > 0.0)) return;
+  for (std::size_t r = 0; r < 32; ++r)
+    std::cout << "  row " << r << ": share of squared error " << row_num[r] / num << ", of luminance^2 "
+              << row_den[r] / den << "\n";
+  std::cout << "  worst pixel x " << worst_i % 64 << " y " << worst_i / 64 << ": share " << worst / num << ", Y "
+            << Y[worst_i] << " against " << ref[worst_i] << "\n";
+}
+
 // The renderer's own estimate over the same pixels (ErrorSums::relative_rms).
 double estimated_error(const std::vector<FilmTile>& film, const std::vector<bool>& keep) {
   ErrorSums sums;
@@ -191,6 +215,8 @@ int run_bench_convergence(const std::vector<std::string>& args) {
   IntegratorOptions options;
   std::optional<bool> roulette_control;  // the plan's choice unless given
   bool adaptive = false;                  // variance-aware sample allocation (sample_allocation.h)
+  std::optional<bool> shadow_guide;      // the plan's choice unless given
+  bool breakdown = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     if (args[i] == "--out" && i + 1 < args.size()) dir = args[++i];
     else if (args[i] == "--scene" && i + 1 < args.size()) only = args[++i];
@@ -216,11 +242,16 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       roulette_control = false;
     else if (args[i] == "--adaptive")
       adaptive = true;
+    else if (args[i] == "--no-shadow-guide")
+      shadow_guide = false;
+    else if (args[i] == "--breakdown")
+      breakdown = true;
     else if (args[i] != "convergence") {
       std::cerr << "usage: skyfarm-worker bench convergence [--out DIR] [--passes N] [--scene NAME]"
                    " [--forced-segments K] [--plain-ratio-tracking] [--sunlit-segments]\n"
                    "  [--no-sunlit-in-shadow] [--seed N] [--rr-threshold-in-shadow W] [--max-camera-scale S]\n"
-                   "  [--roulette-control | --no-roulette-control] [--rr-start-depth D] [--adaptive]\n";
+                   "  [--roulette-control | --no-roulette-control] [--rr-start-depth D] [--adaptive]\n"
+                   "  [--no-shadow-guide] [--breakdown]\n";
       return 2;
     }
   }
@@ -231,6 +262,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     const auto request = api::parse_render_request(request_json(s, passes * 16, seed));
     api::RenderSetup setup = api::make_render_setup(request);
     if (roulette_control) setup.plan.roulette_control = *roulette_control;
+    if (shadow_guide) setup.plan.shadow_guide = *shadow_guide;
     setup.plan.adaptive = adaptive;
     const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan, options);
     const std::vector<bool> keep = sky_mask(setup);
@@ -245,6 +277,8 @@ int run_bench_convergence(const std::vector<std::string>& args) {
       truths.push_back(truth);
       estimates.push_back(est);
       csv << elapsed << "," << pass * 16 << "," << truth << "," << est << "\n";
+      if (breakdown && pass == setup.plan.passes)
+        print_error_breakdown(luminance_of(film, 64, 32, setup.plan.mirrored), ref, keep);
     };
     Image image(64, 32);
     render_image_progressive(renderer, &image, 0, stop);
@@ -262,6 +296,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
                                 {"samples_per_pixel", passes * 16},
                                 {"forced_collision_segments", options.forced_collision_segments},
                                 {"roulette_control", setup.plan.roulette_control},
+                                {"shadow_guide", setup.plan.shadow_guide},
                                 {"adaptive", adaptive},
                                 {"fitted_slope", fitted_slope(times, truths)},
                                 {"worst_estimate_ratio", worst},

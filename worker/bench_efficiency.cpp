@@ -13,6 +13,8 @@
 #include "common/core/constants.h"
 #include "common/render/radiance_control.h"
 #include "common/render/scene.h"
+#include "common/render/shadow_guide.h"
+#include "common/render/render_plan.h"
 #include "common/render/volume_path_integrator.h"
 
 namespace skyfarm {
@@ -31,12 +33,14 @@ glm::dvec3 direction(double zenith_deg, double azimuth_deg) {
   return {std::sin(z) * std::sin(a), std::sin(z) * std::cos(a), std::cos(z)};
 }
 
-EfficiencyResult measure(double sun_zenith_deg, int samples, IntegratorOptions options, bool roulette_control) {
+EfficiencyResult measure(double sun_zenith_deg, int samples, IntegratorOptions options, bool roulette_control,
+                         bool shadow_guide) {
   SunSpec sun;
   sun.zenith_deg = sun_zenith_deg;
   sun.azimuth_deg = 180.0;
   const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun, Location{}, std::nullopt, 360.0, 830.0);
   if (roulette_control) options.roulette_control = std::make_shared<const RadianceControl>(scene);
+  if (shadow_guide && shadow_guide_pays(sun_zenith_deg)) options.shadow_guide = std::make_shared<const ShadowGuide>(scene);
   const VolumePathIntegrator integrator(scene, options);
   SampledWavelengths wl;
   wl.lambda_nm.fill(550.0);
@@ -81,7 +85,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
   int samples = 1000;
   std::vector<double> suns;
   IntegratorOptions options;
-  bool breakdown = false, roulette_control = false;
+  bool breakdown = false, roulette_control = false, shadow_guide = false;
   for (std::size_t i = 1; i < args.size(); ++i) {  // args[0] is "efficiency"
     if (args[i] == "--samples" && i + 1 < args.size()) {
       samples = std::max(2, std::atoi(args[++i].c_str()));
@@ -105,6 +109,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       breakdown = true;
     } else if (args[i] == "--roulette-control") {
       roulette_control = true;
+    } else if (args[i] == "--shadow-guide") {
+      shadow_guide = true;
     } else if (args[i] == "--sunlit-segments") {
       options.explicit_single_scattering = true;
     } else if (args[i] == "--residual-below-cos" && i + 1 < args.size()) {
@@ -120,13 +126,13 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
                    "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
                    "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n"
-                   "  [--roulette-control]\n";
+                   "  [--roulette-control] [--shadow-guide]\n";
       return 2;
     }
   }
   if (suns.empty()) suns = {30.0, 85.0, 96.0};
   for (const double sun : suns) {
-    const EfficiencyResult r = measure(sun, samples, options, roulette_control);
+    const EfficiencyResult r = measure(sun, samples, options, roulette_control, shadow_guide);
     const double rel2 = r.relative_std_per_path * r.relative_std_per_path;
     std::cout << nlohmann::json{{"bench", "efficiency"},
                                 {"sun_zenith_deg", sun},
@@ -135,6 +141,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                                 {"sunlit_segments", options.explicit_single_scattering},
                                 {"residual_ratio_tracking", options.residual_ratio_tracking},
                                 {"roulette_control", roulette_control},
+                                {"shadow_guide", shadow_guide && shadow_guide_pays(sun)},
                                 {"relative_std_per_path", r.relative_std_per_path},
                                 {"microseconds_per_path", r.microseconds_per_path},
                                 {"efficiency", rel2 > 0.0 ? 1.0 / (rel2 * r.microseconds_per_path) : 0.0},
