@@ -69,7 +69,7 @@ struct RenderPlan {
   // path-traced renders with the sun below the observer's horizon, where
   // the light of the dark air comes from a small part of the sky.  By day no
   // vertex would use it (the sun is below few vertices' horizontal), and at
-  // sunset (90 deg) it measured the same error for ~0.4 s of building.
+  // sunset (90 deg) it measured the same error for ~0.14 s of building.
   bool shadow_guide = false;
   // Variance-aware sample allocation after a uniform pilot pass
   // (sample_allocation.h): path-traced plans of two passes or more whose

@@ -25,8 +25,9 @@
 // Within a cell, mu and phi are uniform (the cell's solid angle is
 // d(mu) d(phi)); the side of the sun's vertical plane is a coin.
 // Built per job for path-traced renders with the sun below the observer's
-// horizon (RenderPlan::shadow_guide); 12 x 12 nodes of 48 x 32 cells march
-// 221 184 rays through coarse LUT tables (~0.4 s, 5 MB).  Measured in
+// horizon (RenderPlan::shadow_guide); 8 x 12 nodes of 32 x 24 cells march
+// 73 728 rays through coarse LUT tables (~0.14 s on one core, 1.2 MB; 12
+// altitudes of 48 x 32 cells cost 0.5 s for no gain).  Measured in
 // docs/physics.md, "The shadow guide".
 #pragma once
 #include <vector>
@@ -38,7 +39,7 @@
 namespace skyfarm {
 
 struct ShadowGuideResolution {
-  int altitudes = 12, sun_angles = 12, mu_cells = 48, phi_cells = 32;
+  int altitudes = 8, sun_angles = 12, mu_cells = 32, phi_cells = 24;
   int bins = 4, steps = 8;
   double sun_window_deg = 12.0;
 };

@@ -145,8 +145,8 @@ struct IntegratorOptions {
   // above; the pdf is the mixture with the phase function's.  Null: the
   // lobe.  Built per job when the sun is below the observer's horizon
   // (RenderPlan::shadow_guide).  Twilight (96 deg), bench convergence, 512
-  // spp, 16 seeds: true error RMS 0.30 -> 0.21, median 0.31 -> 0.20, for
-  // ~1.08x the time per path (docs/physics.md, "The shadow guide").
+  // spp, 16 seeds: true error RMS 0.30 -> 0.20, median 0.31 -> 0.18, for
+  // ~1.1x the time per path (docs/physics.md, "The shadow guide").
   std::shared_ptr<const ShadowGuide> shadow_guide;
   double shadow_guide_fraction = 0.3;
 };
