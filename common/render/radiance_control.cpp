@@ -10,16 +10,11 @@
 #include "common/core/constants.h"
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
+#include "common/render/sun_angle_nodes.h"
 
 namespace skyfarm {
 
 namespace {
-
-// Any unit vector perpendicular to unit v.
-glm::dvec3 perpendicular(const glm::dvec3& v) {
-  const glm::dvec3 a = std::abs(v.x) < 0.9 ? glm::dvec3(1.0, 0.0, 0.0) : glm::dvec3(0.0, 1.0, 0.0);
-  return glm::normalize(a - glm::dot(a, v) * v);
-}
 
 // cos of the horizon's zenith angle seen from radius r over a planet of radius R.
 double horizon_mu(double r, double R) { return -std::sqrt(std::max(0.0, 1.0 - (R / r) * (R / r))); }
@@ -34,12 +29,9 @@ RadianceControl::RadianceControl(const Scene& scene, const RadianceControlResolu
   R_ = atmosphere.planet_radius_m();
   top_ = atmosphere.top_radius_m() - R_;
   sun_ = scene.sun().direction();
-  const glm::dvec3 up_observer = glm::normalize(scene.observer());
-  const double zenith_observer = std::acos(std::clamp(glm::dot(up_observer, sun_), -1.0, 1.0));
-  const double horizon_angle = std::acos(std::clamp(R_ / glm::length(scene.observer()), -1.0, 1.0));
-  const double window = res_.sun_window_deg * kDegToRad + horizon_angle;
-  sun_zenith_lo_ = std::max(0.0, zenith_observer - window);
-  sun_zenith_step_ = (std::min(kPi, zenith_observer + window) - sun_zenith_lo_) / (res_.sun_angles - 1);
+  const SunZenithWindow window = vertex_sun_zenith_window(scene, res_.sun_window_deg);
+  sun_zenith_lo_ = window.lo;
+  sun_zenith_step_ = (window.hi - sun_zenith_lo_) / (res_.sun_angles - 1);
   lambda_min_ = scene.lambda_min_nm();
   const double range_nm = scene.lambda_max_nm() - scene.lambda_min_nm();
   bins_ = std::clamp(static_cast<int>(range_nm / 20.0), 1, res_.bins);
@@ -113,11 +105,8 @@ double RadianceControl::cos_azimuth_of(int k) const { return 1.0 - 2.0 * k / (re
 // node's; wi at the node's view zenith and azimuth from the sun's.
 void RadianceControl::node_geometry(int a, int m, int s, int k, glm::dvec3* p, glm::dvec3* wi) const {
   const double r = R_ + altitude_of(a);
-  const double theta_s = sun_zenith_of(s);
-  const glm::dvec3 e1 = perpendicular(sun_);
-  const glm::dvec3 up = std::cos(theta_s) * sun_ + std::sin(theta_s) * e1;
-  const glm::dvec3 towards_sun = std::sin(theta_s) * sun_ - std::cos(theta_s) * e1;  // horizontal at p
-  const glm::dvec3 b = glm::cross(up, towards_sun);
+  const SunNodeFrame f = sun_node_frame(sun_, sun_zenith_of(s));
+  const glm::dvec3 &up = f.up, &towards_sun = f.towards_sun, &b = f.side;
   const double mu = std::clamp(mu_of(m, r), -1.0, 1.0), sin_view = std::sqrt(std::max(0.0, 1.0 - mu * mu));
   const double cos_phi = cos_azimuth_of(k), sin_phi = std::sqrt(std::max(0.0, 1.0 - cos_phi * cos_phi));
   *p = r * up;

@@ -14,12 +14,6 @@ namespace skyfarm {
 
 namespace {
 
-// Any unit vector perpendicular to unit v.
-glm::dvec3 perpendicular(const glm::dvec3& v) {
-  const glm::dvec3 a = std::abs(v.x) < 0.9 ? glm::dvec3(1.0, 0.0, 0.0) : glm::dvec3(0.0, 1.0, 0.0);
-  return glm::normalize(a - glm::dot(a, v) * v);
-}
-
 // The cell index of x in [0, 1) over n cells, clamped.
 int cell_of(double x, int n) { return std::clamp(static_cast<int>(x * n), 0, n - 1); }
 
@@ -39,15 +33,11 @@ ShadowGuide::ShadowGuide(const Scene& scene, const ShadowGuideResolution& resolu
   R_ = atmosphere.planet_radius_m();
   top_ = atmosphere.top_radius_m() - R_;
   sun_ = scene.sun().direction();
-  // The sun's zenith angles at the vertices: a window around the observer's
-  // (as RadianceControl: paths stay near the camera).
-  const glm::dvec3 up_observer = glm::normalize(scene.observer());
-  const double zenith_observer = std::acos(std::clamp(glm::dot(up_observer, sun_), -1.0, 1.0));
-  const double horizon_angle = std::acos(std::clamp(R_ / glm::length(scene.observer()), -1.0, 1.0));
-  const double window = res_.sun_window_deg * kDegToRad + horizon_angle;
-  // Only where the sun is below the local horizontal (covers()).
-  sun_zenith_lo_ = std::max(0.5 * kPi, zenith_observer - window);
-  sun_zenith_step_ = std::max(1e-6, std::min(kPi, zenith_observer + window) - sun_zenith_lo_) / (res_.sun_angles - 1);
+  // The sun's zenith angles at the vertices, where it is below their
+  // horizontal (covers()).
+  const SunZenithWindow window = vertex_sun_zenith_window(scene, res_.sun_window_deg);
+  sun_zenith_lo_ = std::max(0.5 * kPi, window.lo);
+  sun_zenith_step_ = std::max(1e-6, window.hi - sun_zenith_lo_) / (res_.sun_angles - 1);
 
   const double range_nm = scene.lambda_max_nm() - scene.lambda_min_nm();
   const int bins = std::clamp(static_cast<int>(range_nm / 20.0), 1, res_.bins);
@@ -59,16 +49,13 @@ ShadowGuide::ShadowGuide(const Scene& scene, const ShadowGuideResolution& resolu
   cdf_rows_.assign(static_cast<std::size_t>(nodes) * (J + 1), 0.0);
   cdf_cols_.assign(static_cast<std::size_t>(nodes) * J * (K + 1), 0.0);
   std::vector<double> L(static_cast<std::size_t>(bins));
-  const glm::dvec3 e1 = perpendicular(sun_);
   for (int a = 0; a < res_.altitudes; ++a) {
     const double u = static_cast<double>(a) / (res_.altitudes - 1);
     const double r = R_ + top_ * u * u;
     for (int s = 0; s < res_.sun_angles; ++s) {
       const int node = a * res_.sun_angles + s;
-      const double theta_s = sun_zenith_lo_ + s * sun_zenith_step_;
-      const glm::dvec3 up = std::cos(theta_s) * sun_ + std::sin(theta_s) * e1;
-      const glm::dvec3 towards_sun = std::sin(theta_s) * sun_ - std::cos(theta_s) * e1;
-      const glm::dvec3 side = glm::cross(up, towards_sun);
+      const SunNodeFrame f = sun_node_frame(sun_, sun_zenith_lo_ + s * sun_zenith_step_);
+      const glm::dvec3 &up = f.up, &towards_sun = f.towards_sun, &side = f.side;
       // --- Cell values: the LUT's radiance at each cell's centre direction.
       double* rows = &cdf_rows_[static_cast<std::size_t>(node) * (J + 1)];
       for (int j = 0; j < J; ++j) {
@@ -110,7 +97,7 @@ double ShadowGuide::phi_edge(int k) const {
   return kPi * v * v;
 }
 
-bool ShadowGuide::local_frame(const glm::dvec3& p, Frame3* f) const {
+bool ShadowGuide::local_frame(const glm::dvec3& p, SunNodeFrame* f) const {
   f->up = glm::normalize(p);
   const glm::dvec3 t = sun_ - glm::dot(sun_, f->up) * f->up;
   const double len = glm::length(t);
@@ -133,12 +120,12 @@ int ShadowGuide::node_of(const glm::dvec3& p) const {
 
 bool ShadowGuide::covers(const glm::dvec3& p) const {
   if (!(glm::dot(p, sun_) < 0.0)) return false;
-  Frame3 f;
+  SunNodeFrame f;
   return local_frame(p, &f) && usable_[static_cast<std::size_t>(node_of(p))];
 }
 
 glm::dvec3 ShadowGuide::sample(const glm::dvec3& p, double u1, double u2, double u3, double* pdf_out) const {
-  Frame3 f;
+  SunNodeFrame f;
   local_frame(p, &f);
   const int node = node_of(p), J = res_.mu_cells, K = res_.phi_cells;
   // --- A row by its mass, then a cell in it; the remainders place mu and phi.
@@ -159,7 +146,7 @@ glm::dvec3 ShadowGuide::sample(const glm::dvec3& p, double u1, double u2, double
 }
 
 double ShadowGuide::pdf(const glm::dvec3& p, const glm::dvec3& wi) const {
-  Frame3 f;
+  SunNodeFrame f;
   if (!local_frame(p, &f)) return 0.0;
   const int node = node_of(p);
   if (!usable_[static_cast<std::size_t>(node)]) return 0.0;

@@ -35,6 +35,7 @@
 #include <glm/vec3.hpp>
 
 #include "common/render/scene.h"
+#include "common/render/sun_angle_nodes.h"
 
 namespace skyfarm {
 
@@ -59,10 +60,7 @@ class ShadowGuide {
   std::size_t memory_bytes() const { return (cdf_rows_.size() + cdf_cols_.size() + density_.size()) * sizeof(double); }
 
  private:
-  struct Frame3 {
-    glm::dvec3 up, towards_sun, side;
-  };
-  bool local_frame(const glm::dvec3& p, Frame3* f) const;
+  bool local_frame(const glm::dvec3& p, SunNodeFrame* f) const;
   int node_of(const glm::dvec3& p) const;
   double mu_edge(int j) const;
   double phi_edge(int k) const;
