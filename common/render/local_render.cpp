@@ -1,5 +1,6 @@
 #include "common/render/local_render.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <mutex>
@@ -79,22 +80,50 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
   std::int64_t done = 0;  // units (tile passes): 131072 x 65536 for the largest open-ended frame
   std::mutex mutex;
   GroundPool pool(plan.pooled_ground_row, plan.batches);  // of the film after each pass
-  for (int p = 0; p < plan.passes; ++p) {
-    parallel_for(static_cast<std::size_t>(tiles), threads, [&](std::size_t t, int) {
-      FilmTile pass = renderer.empty_tile(static_cast<int>(t));
-      const std::vector<PassSamples> samples =
-          r.allocation && p > 0 ? r.allocation->tile(static_cast<int>(t)) : std::vector<PassSamples>{};
-      for (int b = 0; b < plan.batches; ++b)
-        renderer.render_unit({static_cast<int>(t), b, p, samples}, &pass, &counters[t]);
-      film[t].merge(pass);
-      if (progress) {
-        const std::lock_guard<std::mutex> lock(mutex);
-        const double samples_share =
-            static_cast<double>(++done) / (static_cast<double>(tiles) * static_cast<double>(plan.passes));
-        progress(render_progress(samples_share, seconds_since(t0), stop.time_limit_s, stop.target_relative_error,
-                                 r.estimate));
-      }
-    });
+  // Frames of fewer tiles than threads render several passes at once (a
+  // frame of one tile would use one core); each tile's passes are merged in
+  // pass order and each pass is evaluated in turn (error, stop criteria), so
+  // the bytes and the stopping pass are those of one pass at a time; passes
+  // rendered beyond the stop are dropped.  The adaptive pilot (pass 0) goes
+  // alone: the passes after it need its allocation.
+  const int workers = resolve_thread_count(threads);
+  const int group = std::max(1, (workers + tiles - 1) / tiles);
+  std::vector<std::vector<PathCounters>> unit_counters(
+      static_cast<std::size_t>(group), std::vector<PathCounters>(static_cast<std::size_t>(tiles)));
+  std::vector<FilmTile> passes_film;  // [pass in group * tiles + tile]
+  double group_start = 0.0;
+  for (int p = 0, group_end = 0; p < plan.passes; ++p) {
+    if (p == group_end) {  // --- render passes [p, group_end) of every tile
+      group_end = std::min(plan.passes, p + ((p == 0 && plan.adaptive) ? 1 : group));
+      const int k = group_end - p;
+      group_start = seconds_since(t0);
+      passes_film.clear();
+      for (int j = 0; j < k; ++j)
+        for (int t = 0; t < tiles; ++t) passes_film.push_back(renderer.empty_tile(t));
+      parallel_for(static_cast<std::size_t>(k) * static_cast<std::size_t>(tiles), threads, [&](std::size_t u, int) {
+        const int j = static_cast<int>(u) / tiles, t = static_cast<int>(u) % tiles, pass_index = p + j;
+        const std::vector<PassSamples> samples = r.allocation && pass_index > 0
+                                                     ? r.allocation->tile(t)
+                                                     : std::vector<PassSamples>{};
+        for (int b = 0; b < plan.batches; ++b)
+          renderer.render_unit({t, b, pass_index, samples}, &passes_film[u],
+                               &unit_counters[static_cast<std::size_t>(j)][static_cast<std::size_t>(t)]);
+        if (progress) {
+          const std::lock_guard<std::mutex> lock(mutex);
+          const double samples_share =
+              static_cast<double>(++done) / (static_cast<double>(tiles) * static_cast<double>(plan.passes));
+          progress(render_progress(samples_share, seconds_since(t0), stop.time_limit_s, stop.target_relative_error,
+                                   r.estimate));
+        }
+      });
+    }
+    // --- pass p: merged into the film in pass order, then evaluated
+    const int j = p - (group_end - static_cast<int>(passes_film.size()) / tiles);
+    for (int t = 0; t < tiles; ++t) {
+      film[static_cast<std::size_t>(t)].merge(passes_film[static_cast<std::size_t>(j * tiles + t)]);
+      counters[static_cast<std::size_t>(t)].add(unit_counters[static_cast<std::size_t>(j)][static_cast<std::size_t>(t)]);
+      unit_counters[static_cast<std::size_t>(j)][static_cast<std::size_t>(t)] = PathCounters{};
+    }
     r.passes = p + 1;
     if (p == 0 && plan.adaptive) r.allocation = SampleAllocation::from_pilot(plan, film, renderer.sun_pixels());
     r.samples_per_pixel = r.allocation ? r.allocation->mean_samples_per_pixel(plan, r.passes)
@@ -108,7 +137,10 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     r.estimated_relative_rms = r.estimate.value_or(0.0);
     r.pixels_without_estimate = error.unknown;
     r.error = error;
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // The passes of a group share its time, in equal parts.
+    const int in_group = static_cast<int>(passes_film.size()) / tiles;
+    const double elapsed =
+        group_start + (seconds_since(t0) - group_start) * (j + 1) / static_cast<double>(in_group);
     r.history.emplace_back(elapsed, r.estimated_relative_rms);
     if (stop.after_pass) {  // the film as the image shows it
       if (pool.active()) {

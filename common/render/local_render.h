@@ -54,8 +54,11 @@ struct ProgressiveResult : LocalRenderResult {
 
 // Renders pass by pass over the whole frame (all tiles of pass p before any
 // of pass p + 1; an adaptive plan's allocation from pass 0, the pilot) and stops by `stop`; the same passes and stopping rule as the
-// farm, so the same request gives the same bytes.  Keeps the whole film in
-// memory (width x height x batches x 48 bytes), unlike render_image().
+// farm, so the same request gives the same bytes.  A frame of fewer tiles
+// than threads renders several passes at once and evaluates them one by one
+// (the same bytes and stopping pass; a 64x32 mirrored frame, one tile, used
+// one core of two before).  Keeps the whole film in memory (width x height x
+// batches x 48 bytes), unlike render_image().
 ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* image, int threads,
                                            const StopCriteria& stop, const RenderProgress& progress = {});
 

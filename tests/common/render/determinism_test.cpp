@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <optional>
 #include <random>
+#include <vector>
 
 #include "common/render/local_render.h"
 #include "common/render/tile_renderer.h"
@@ -77,6 +79,42 @@ TEST(Determinism, ImageDoesNotDependOnThreadCount) {
   render_image(r, &three, 3);
   for (int y = 0; y < 12; ++y)
     for (int x = 0; x < 24; ++x) ASSERT_EQ(one.rgb(x, y), three.rgb(x, y)) << x << "," << y;
+}
+
+// A frame of one tile renders several passes at once on several threads
+// (local_render.cpp); its bytes, its stopping pass and its counters are those
+// of one pass at a time, by target error and by samples alike, and every pass
+// is reported in order.
+TEST(Determinism, ProgressiveOneTileFrameDoesNotDependOnThreadCount) {
+  const Fixture f = make_fixture(8, 8, 160);  // tile size 8: one tile, 10 passes of 16
+  ASSERT_EQ(f.plan.tile_count(), 1);
+  const TileRenderer r(f.scene, f.camera, f.plan);
+  for (const std::optional<double> target : {std::optional<double>(), std::optional<double>(0.08)}) {
+    std::vector<Image> images;
+    std::vector<ProgressiveResult> results;
+    for (const int threads : {1, 3, 4}) {
+      StopCriteria stop;
+      stop.target_relative_error = target;
+      std::vector<int> reported;
+      stop.after_pass = [&](int pass, const std::vector<FilmTile>&, double) { reported.push_back(pass); };
+      images.emplace_back(8, 8);
+      results.push_back(render_image_progressive(r, &images.back(), threads, stop));
+      for (std::size_t i = 0; i < reported.size(); ++i) EXPECT_EQ(reported[i], static_cast<int>(i) + 1);
+      EXPECT_EQ(static_cast<int>(reported.size()), results.back().passes);
+    }
+    if (target) {  // the test needs a stop before the last pass
+      EXPECT_EQ(results[0].stopped_by, "target_error");
+      EXPECT_LT(results[0].passes, f.plan.passes);
+    }
+    for (std::size_t k = 1; k < results.size(); ++k) {
+      EXPECT_EQ(results[k].passes, results[0].passes);
+      EXPECT_EQ(results[k].stopped_by, results[0].stopped_by);
+      EXPECT_EQ(results[k].counters.paths, results[0].counters.paths);
+      EXPECT_EQ(results[k].counters.collisions, results[0].counters.collisions);
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) ASSERT_EQ(images[k].rgb(x, y), images[0].rgb(x, y)) << x << "," << y;
+    }
+  }
 }
 
 TEST(Determinism, SeedChangesTheImage) {
