@@ -92,8 +92,9 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       static_cast<std::size_t>(group), std::vector<PathCounters>(static_cast<std::size_t>(tiles)));
   std::vector<FilmTile> passes_film;  // [pass in group * tiles + tile]
   double group_start = 0.0;
-  for (int p = 0, group_end = 0; p < plan.passes; ++p) {
+  for (int p = 0, group_begin = 0, group_end = 0; p < plan.passes; ++p) {
     if (p == group_end) {  // --- render passes [p, group_end) of every tile
+      group_begin = p;
       group_end = std::min(plan.passes, p + ((p == 0 && plan.adaptive) ? 1 : group));
       const int k = group_end - p;
       group_start = seconds_since(t0);
@@ -118,7 +119,7 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
       });
     }
     // --- pass p: merged into the film in pass order, then evaluated
-    const int j = p - (group_end - static_cast<int>(passes_film.size()) / tiles);
+    const int j = p - group_begin;
     for (int t = 0; t < tiles; ++t) {
       film[static_cast<std::size_t>(t)].merge(passes_film[static_cast<std::size_t>(j * tiles + t)]);
       counters[static_cast<std::size_t>(t)].add(unit_counters[static_cast<std::size_t>(j)][static_cast<std::size_t>(t)]);
@@ -138,9 +139,8 @@ ProgressiveResult render_image_progressive(const TileRenderer& renderer, Image* 
     r.pixels_without_estimate = error.unknown;
     r.error = error;
     // The passes of a group share its time, in equal parts.
-    const int in_group = static_cast<int>(passes_film.size()) / tiles;
     const double elapsed =
-        group_start + (seconds_since(t0) - group_start) * (j + 1) / static_cast<double>(in_group);
+        group_start + (seconds_since(t0) - group_start) * (j + 1) / static_cast<double>(group_end - group_begin);
     r.history.emplace_back(elapsed, r.estimated_relative_rms);
     if (stop.after_pass) {  // the film as the image shows it
       if (pool.active()) {

@@ -124,7 +124,7 @@ bool ShadowGuide::covers(const glm::dvec3& p) const {
   return local_frame(p, &f) && usable_[static_cast<std::size_t>(node_of(p))];
 }
 
-glm::dvec3 ShadowGuide::sample(const glm::dvec3& p, double u1, double u2, double u3, double* pdf_out) const {
+glm::dvec3 ShadowGuide::sample(const glm::dvec3& p, double u1, double u2, double u3) const {
   SunNodeFrame f;
   local_frame(p, &f);
   const int node = node_of(p), J = res_.mu_cells, K = res_.phi_cells;
@@ -139,10 +139,7 @@ glm::dvec3 ShadowGuide::sample(const glm::dvec3& p, double u1, double u2, double
   const double phi = phi_edge(k) + tk * (phi_edge(k + 1) - phi_edge(k));
   const double side = u3 < 0.5 ? 1.0 : -1.0;
   const double sin_view = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-  const glm::dvec3 wi =
-      glm::normalize(mu * f.up + sin_view * (std::cos(phi) * f.towards_sun + side * std::sin(phi) * f.side));
-  *pdf_out = pdf(p, wi);
-  return wi;
+  return glm::normalize(mu * f.up + sin_view * (std::cos(phi) * f.towards_sun + side * std::sin(phi) * f.side));
 }
 
 double ShadowGuide::pdf(const glm::dvec3& p, const glm::dvec3& wi) const {

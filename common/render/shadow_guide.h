@@ -52,9 +52,9 @@ class ShadowGuide {
   // Whether the guide applies at p (planet-centred): the sun below p's
   // local horizontal and p's node has light to guide towards.
   bool covers(const glm::dvec3& p) const;
-  // A direction from p's node's distribution (u in [0,1)^3) and its pdf per
-  // steradian; p must be covered.
-  glm::dvec3 sample(const glm::dvec3& p, double u1, double u2, double u3, double* pdf) const;
+  // A direction from p's node's distribution (u in [0,1)^3); p must be
+  // covered.  Its pdf per steradian is pdf(p, wi).
+  glm::dvec3 sample(const glm::dvec3& p, double u1, double u2, double u3) const;
   double pdf(const glm::dvec3& p, const glm::dvec3& wi) const;
 
   std::size_t memory_bytes() const { return (cdf_rows_.size() + cdf_cols_.size() + density_.size()) * sizeof(double); }

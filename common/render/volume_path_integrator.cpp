@@ -307,6 +307,25 @@ std::optional<glm::dvec3> VolumePathIntegrator::twilight_guide(const glm::dvec3&
   return std::cos(kGuideElevation_rad) * (towards_sun / len) + std::sin(kGuideElevation_rad) * n;
 }
 
+// The pdf of direction wi at the medium vertex p, per wavelength: the phase
+// function's p_phase mixed with the shadow guide's table or, without it, the
+// twilight guide's lobe (each at its share of the directions).  One function
+// for the sampling and the sun NEE's MIS, which must agree.
+SampledSpectrum VolumePathIntegrator::direction_pdf(const glm::dvec3& p, const glm::dvec3& wi,
+                                                    const SampledSpectrum& p_phase, const ShadowGuide* table,
+                                                    const std::optional<glm::dvec3>& guide) const {
+  if (table) {
+    const double alpha = options_.shadow_guide_fraction;
+    return p_phase * (1.0 - alpha) + SampledSpectrum(alpha * table->pdf(p, wi));
+  }
+  if (guide) {
+    const double alpha = options_.twilight_guide_fraction;
+    return p_phase * (1.0 - alpha) +
+           SampledSpectrum(alpha * square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa));
+  }
+  return p_phase;
+}
+
 // A real scattering in the medium at p: the next direction from the mixture
 // phase function (a constituent picked by its share of sigma_s at the hero
 // wavelength, then its phase function sampled) or, in the planet's shadow,
@@ -320,9 +339,8 @@ bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPo
   glm::dvec3 wi;
   if ((table || guide) && sampler.next() < alpha) {
     if (table) {
-      double unused = 0.0;
       const double u1 = sampler.next(), u2 = sampler.next(), u3 = sampler.next();
-      wi = table->sample(p, u1, u2, u3, &unused);
+      wi = table->sample(p, u1, u2, u3);
     } else {
       const glm::dvec3 local = square_to_von_mises_fisher({sampler.next(), sampler.next()}, kGuideKappa);
       wi = glm::normalize(Frame(*guide).to_world(local));
@@ -341,13 +359,7 @@ bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPo
     wi = glm::normalize(Frame(ray->d).to_world({sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu}));
   }
   const SampledSpectrum p_mix = mixture_phase(mp, phases, clamp_cos(glm::dot(ray->d, wi)));
-  SampledSpectrum pdf = p_mix;  // per wavelength, had it been the hero
-  if (table) {
-    pdf = p_mix * (1.0 - alpha) + SampledSpectrum(alpha * table->pdf(p, wi));
-  } else if (guide) {
-    const double p_guide = square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa);
-    pdf = p_mix * (1.0 - alpha) + SampledSpectrum(alpha * p_guide);
-  }
+  const SampledSpectrum pdf = direction_pdf(p, wi, p_mix, table, guide);  // per wavelength, had it been the hero
   const double pdf_dir = pdf[0];
   if (!(pdf_dir > 0.0)) return false;
   st->r_l = st->r_u * (1.0 / pdf_dir);
@@ -487,15 +499,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
-    pdf_scatter = f;
-    if (const ShadowGuide* table = shadow_guide_at(v.p)) {
-      const double alpha = options_.shadow_guide_fraction;
-      pdf_scatter = f * (1.0 - alpha) + SampledSpectrum(alpha * table->pdf(v.p, wi));
-    } else if (const std::optional<glm::dvec3> guide = twilight_guide(v.p)) {  // (penumbra: the disk partly seen)
-      const double alpha = options_.twilight_guide_fraction;
-      pdf_scatter = f * (1.0 - alpha) + SampledSpectrum(
-          alpha * square_to_von_mises_fisher_pdf(clamp_cos(glm::dot(*guide, wi)), kGuideKappa));
-    }
+    const ShadowGuide* table = shadow_guide_at(v.p);  // (penumbra: the disk partly seen)
+    pdf_scatter = direction_pdf(v.p, wi, f, table, table ? std::nullopt : twilight_guide(v.p));
   }
   if (f.is_zero()) return SampledSpectrum(0.0);
 

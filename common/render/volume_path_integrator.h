@@ -235,6 +235,8 @@ class VolumePathIntegrator {
   // The twilight guide's axis at p (in the planet's shadow), or nothing.
   std::optional<glm::dvec3> twilight_guide(const glm::dvec3& p) const;
   const ShadowGuide* shadow_guide_at(const glm::dvec3& p) const;
+  SampledSpectrum direction_pdf(const glm::dvec3& p, const glm::dvec3& wi, const SampledSpectrum& p_phase,
+                                const ShadowGuide* table, const std::optional<glm::dvec3>& guide) const;
   struct SunlitSample {
     SampledSpectrum L{0.0}, r{1.0};
   };
