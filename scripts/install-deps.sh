@@ -11,6 +11,8 @@ packages=(
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   ffmpeg
+  file                        # cpack -G DEB finds the programs' libraries with it
+  yamllint python3-yaml       # the deployment files' tests (tests/deploy)
 )
 for arg in "$@"; do
   case $arg in
