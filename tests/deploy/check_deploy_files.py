@@ -25,7 +25,8 @@ What is checked (every failure is printed; exit 1 if any):
   secrets, volumes, the health check's port.  Dockerfile: Debian bookworm
   stages, non-root USER, HEALTHCHECK, VOLUME at the data dir, EXPOSE the ports,
   COPY sources that exist.  systemd: credentials the units use are loaded.
-  yaml comes from python3-yaml.
+  yaml comes from python3-yaml; `kubectl kustomize` renders the kustomization
+  where kubectl is installed.
 """
 import argparse
 import glob
@@ -33,6 +34,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import signal
 import socket
 import subprocess
@@ -199,8 +201,14 @@ def served_metrics(server_binary):
                     if proc.poll() is not None or time.monotonic() > deadline:
                         sys.exit("skyfarm-server did not answer /healthz: " + proc.stdout.read().decode())
                     time.sleep(0.1)
-            with urllib.request.urlopen(f"http://127.0.0.1:{http}/metrics", timeout=5) as r:
-                text = r.read().decode()
+            try:
+                with urllib.request.urlopen(f"http://127.0.0.1:{http}/metrics", timeout=5) as r:
+                    text = r.read().decode()
+            except (OSError, ValueError) as e:
+                time.sleep(0.2)
+                exited = proc.poll()
+                sys.exit(f"skyfarm-server gave no /metrics ({e})" +
+                         (f"; it exited with {exited}" if exited is not None else ""))
         finally:
             proc.send_signal(signal.SIGTERM)
             try:
@@ -259,6 +267,14 @@ def check_k8s(source, programs, metrics):
     k8s_dir = os.path.join(source, "deploy", "k8s")
     objects = load_k8s(k8s_dir)
     kust = yaml.safe_load(open(os.path.join(k8s_dir, "kustomization.yaml"), encoding="utf-8"))
+    # kubectl is no Debian package: kustomize's own rendering only where it is installed.
+    kubectl = shutil.which("kubectl")
+    if kubectl:
+        out = subprocess.run([kubectl, "kustomize", k8s_dir], capture_output=True, text=True, timeout=60)
+        if out.returncode != 0:
+            error("kustomization.yaml", f"kubectl kustomize failed: {out.stderr.strip()}")
+    else:
+        notes.append("kubectl is not installed: kustomization.yaml not rendered by kustomize")
 
     # kustomization.yaml: the files, one autoscaler, the namespace.
     listed = set(kust.get("resources", []))
