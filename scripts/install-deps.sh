@@ -10,7 +10,7 @@ packages=(
   libopenexr-dev libimath-dev libglm-dev nlohmann-json3-dev libpng-dev
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  ffmpeg
+  ffmpeg tcpdump iproute2
 )
 for arg in "$@"; do
   case $arg in
