@@ -4,6 +4,10 @@
 // 30 s while it keeps failing).  stop() sends SIGTERM (workers drain their
 // units), waits up to 5 s, then SIGKILLs what is left.  Local workers get
 // SIGTERM when the server process dies, however it dies (PR_SET_PDEATHSIG).
+// Credentials travel in the environment, never argv (/proc/PID/cmdline is
+// world-readable, /proc/PID/environ is not): SKYFARM_WORKER_SECRET (the
+// shared worker secret) and SKYFARM_SERVER_KEY (the server's public key);
+// the server's own SKYFARM_* credential variables are not passed on.
 #pragma once
 #include <atomic>
 #include <mutex>
@@ -19,7 +23,8 @@ struct LocalWorkerOptions {
   std::string endpoint;       // the broker's bound endpoint
   int count = 0;
   int threads_each = 1;
-  std::string token;
+  std::string worker_secret;  // SKYFARM_WORKER_SECRET of every worker
+  std::string server_key;     // SKYFARM_SERVER_KEY (Z85 public key); empty: derived from the secret
 };
 
 class LocalWorkers {
