@@ -327,6 +327,7 @@ TEST_F(FarmWorkerTest, AWorkerWithAnUnknownKeyNeverJoinsAndSaysWhy) {
   ASSERT_TRUE(eventually([&] { return w.worker.stats().auth_failures >= 1; }, 3s));
   EXPECT_GE(broker_->stats().auth_failures, 1u);
   EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty() && f.dispatches.empty(); }));
+  EXPECT_EQ(w.finish(), 0);  // before `lines` goes: the worker logs into it
   std::lock_guard lock(mu);
   EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
                           [](const std::string& l) { return l.find("refused the CURVE handshake") != std::string::npos; }));
