@@ -31,6 +31,7 @@ inline constexpr std::size_t kZ85KeyChars = 40;
 struct CurveKeyPair {
   std::string public_key;
   std::string secret_key;
+  bool operator==(const CurveKeyPair&) const = default;
 };
 
 CurveKeyPair derive_worker_keys(std::string_view secret);
