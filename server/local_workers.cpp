@@ -20,7 +20,11 @@ LocalWorkers::~LocalWorkers() { stop(); }
 
 pid_t LocalWorkers::spawn(int index) {
   const std::string threads = std::to_string(options_.threads_each);
-  const std::string id = "local-" + std::to_string(::getpid()) + "-" + std::to_string(index);
+  // A restarted worker gets a new id: the broker refuses an id whose holder
+  // has not yet missed its heartbeats, and the old process's may not have.
+  const int restarts = restarts_[index]++;
+  const std::string id = "local-" + std::to_string(::getpid()) + "-" + std::to_string(index) +
+                         (restarts > 0 ? "-r" + std::to_string(restarts) : "");
   std::vector<std::string> args = {options_.worker_binary, "--connect", options_.endpoint, "--threads", threads,
                                    "--id", id};
   std::vector<char*> argv;

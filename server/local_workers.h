@@ -10,6 +10,7 @@
 // the server's own SKYFARM_* credential variables are not passed on.
 #pragma once
 #include <atomic>
+#include <map>
 #include <mutex>
 #include <string>
 #include <sys/types.h>
@@ -43,6 +44,7 @@ class LocalWorkers {
   LocalWorkerOptions options_;
   mutable std::mutex mu_;
   std::vector<pid_t> pids_;
+  std::map<int, int> restarts_;  // per slot, guarded by mu_
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
 };
