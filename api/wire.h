@@ -1,6 +1,8 @@
-// The server <-> worker protocol of the render farm (DESIGN §4), as ZeroMQ
-// multipart frames.  The server binds a ROUTER, every worker connects a
-// DEALER.  A DEALER sends and receives
+// The server <-> worker protocol of the render farm, as ZeroMQ multipart
+// frames.  The server binds a ROUTER, every worker connects a DEALER; the
+// connection is CurveZMQ (encrypted, each worker authenticated by its public
+// key in the server's ZAP handler: api/curve_keys.h, server/broker.h), so
+// everything below rides inside CURVE.  A DEALER sends and receives
 //
 //     [command] [header JSON object] [payload]        (payload: RESULT only)
 //
@@ -13,7 +15,8 @@
 //
 //   command     direction        header fields                                  payload
 //   READY       worker -> server id, cores, slots, version, capabilities,      -
-//                                heartbeat_ms?, token?
+//                                heartbeat_ms?, token? (token: sent by workers
+//                                given --token, ignored: not a credential)
 //   HEARTBEAT   both ways        heartbeat_ms? (sender's interval),            -
 //                                draining? (worker: send no more units)
 //   UNIT        server -> worker job, tile, batch, pass, attempt, request,     -
@@ -42,7 +45,9 @@
 // version 1 worker would ignore it and render the wrong samples; 3 since the
 // pooled ground of an observer at 0 m, render_plan.h: a version 2 worker
 // would trace every sample of those pixels); the server refuses another
-// version with a fatal DISCONNECT.  Decoding is strict: an unknown command, a
+// version with a fatal DISCONNECT.  CURVE changed no message, so the version
+// stays 3: an older worker fails the handshake (NULL mechanism) before any
+// READY, which is the refusal it gets.  Decoding is strict: an unknown command, a
 // header that is not a JSON object, a missing or mistyped field, a value out
 // of range or a wrong frame count throws WireError (the receivers count such
 // messages and drop them; nothing here trusts the peer).  Unknown extra
@@ -146,7 +151,7 @@ struct CancelMsg {
 
 struct DisconnectMsg {
   std::string reason;
-  bool fatal = false;  // server -> worker: a refusal (bad token, version); do not retry
+  bool fatal = false;  // server -> worker: a refusal (protocol version, worker id in use); do not retry
   bool operator==(const DisconnectMsg&) const = default;
 };
 

@@ -8,7 +8,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config curl bc
   libopenexr-dev libimath-dev libglm-dev nlohmann-json3-dev libpng-dev
-  libcpp-httplib-dev libzmq3-dev cppzmq-dev libsqlite3-dev
+  libcpp-httplib-dev libzmq3-dev cppzmq-dev libsodium-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   ffmpeg
   file                        # cpack -G DEB finds the programs' libraries with it

@@ -1,7 +1,10 @@
 #include "server/broker.h"
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
+#include <cstring>
+#include <set>
 #include <iostream>
 #include <map>
 #include <unordered_map>
@@ -10,21 +13,13 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
+#include "api/curve_keys.h"
 #include "api/wire.h"
 
 namespace skyfarm::server {
 namespace {
 
 using Ms = std::chrono::milliseconds;
-
-// Constant-time comparison of a shared secret.
-bool same_secret(const std::string& expected, const std::string& given) {
-  unsigned diff = expected.size() == given.size() ? 0u : 1u;
-  for (std::size_t i = 0; i < given.size(); ++i)
-    diff |= static_cast<unsigned>(static_cast<unsigned char>(given[i]) ^
-                                  static_cast<unsigned char>(expected.empty() ? 0 : expected[i % expected.size()]));
-  return diff == 0;
-}
 
 std::string printable(const std::string& bytes) {
   static constexpr char kHex[] = "0123456789abcdef";
@@ -38,13 +33,23 @@ std::string printable(const std::string& bytes) {
 
 UnitKey key_of(const api::UnitRef& u) { return UnitKey{u.job, u.tile, u.batch, u.pass}; }
 
+// Log the first ten, then every power of two: a flood cannot fill the log.
+bool worth_logging(std::uint64_t n) { return n <= 10 || (n & (n - 1)) == 0; }
+
+constexpr const char* kZapEndpoint = "inproc://zeromq.zap.01";  // fixed by the ZAP specification (RFC 27)
+constexpr const char* kMonitorEndpoint = "inproc://skyfarm-broker-monitor";
+constexpr const char* kZapDomain = "skyfarm-workers";
+// A retired attempt cancelled here, remembered so its late answer is not a refusal.
+constexpr std::size_t kMaxCancelledRemembered = 1024;
+
 }  // namespace
 
 struct Broker::Shared {
   std::atomic<bool> stop{false};
   api::WakeupPipe wakeup;
   std::atomic<std::uint64_t> workers{0}, joined{0}, left{0}, lost{0}, rejected{0}, units_sent{0}, results{0},
-      failures{0}, cancels_sent{0}, malformed{0}, unexpected{0}, reregisters_sent{0}, backend_errors{0};
+      failures{0}, cancels_sent{0}, malformed{0}, unexpected{0}, reregisters_sent{0}, backend_errors{0},
+      auth_failures{0}, results_refused{0};
 };
 
 // Everything the broker thread owns.  Built (and bound) in start() on the
@@ -57,14 +62,18 @@ struct Broker::Loop {
     int slots = 1;
     bool draining = false;
     std::map<std::uint64_t, UnitKey> in_flight;  // attempt -> unit
+    std::set<std::uint64_t> cancelled;           // attempts taken back by CANCEL, answers still possible
     Clock::duration expiry_span{};
     Clock::time_point expiry{};
+    Clock::time_point last_heard{};
     bool has_credit() const { return !draining && static_cast<int>(in_flight.size()) < slots; }
   };
 
   Loop(BrokerBackend& backend, const BrokerOptions& options, Shared& shared)
-      : backend_(backend), options_(options), shared_(shared), router_(ctx_, zmq::socket_type::router) {
+      : backend_(backend), options_(options), shared_(shared), router_(ctx_, zmq::socket_type::router),
+        auth_(options.auth, [this](const std::string& line) { log(line); }) {
     router_.set(zmq::sockopt::linger, 0);
+    if (!options_.curve_secret_key.empty()) secure();
     router_.set(zmq::sockopt::router_mandatory, 1);
     router_.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(options_.max_message_bytes));
     router_.set(zmq::sockopt::sndtimeo, 0);
@@ -76,6 +85,11 @@ struct Broker::Loop {
   void run();
 
  private:
+  // --- security
+  void secure();
+  void serve_zap();
+  void read_monitor();
+  void auth_failed(const std::string& what);
   // --- sending
   bool send(const std::string& identity, const api::Message& message);
   void send_or_lose(const std::string& identity, const api::Message& message);
@@ -86,6 +100,7 @@ struct Broker::Loop {
   void handle_known(Worker& w, const api::Message& message);
   void handle_result(Worker& w, const api::ResultMsg& r);
   void handle_failed(Worker& w, const api::FailedMsg& f);
+  bool fenced(Worker& w, const api::UnitRef& u, const char* what);
   // --- workers
   void refuse(const std::string& identity, const std::string& reason);
   void register_worker(const std::string& identity, const api::ReadyMsg& ready);
@@ -108,6 +123,8 @@ struct Broker::Loop {
   Shared& shared_;
   zmq::context_t ctx_{1};
   zmq::socket_t router_;
+  std::optional<zmq::socket_t> zap_, monitor_;
+  WorkerAuth auth_;
   std::string bound_;
   std::map<std::string, Worker> workers_;                  // by identity
   std::unordered_map<std::string, std::string> identity_of_;  // worker id -> identity
@@ -123,10 +140,14 @@ void Broker::Loop::run() {
   next_timeout_check_ = start;
   while (!shared_.stop.load()) {
     zmq::pollitem_t items[] = {{router_.handle(), 0, ZMQ_POLLIN, 0},
-                               {nullptr, shared_.wakeup.read_fd(), ZMQ_POLLIN, 0}};
+                               {nullptr, shared_.wakeup.read_fd(), ZMQ_POLLIN, 0},
+                               {zap_ ? zap_->handle() : nullptr, -1, ZMQ_POLLIN, 0},
+                               {monitor_ ? monitor_->handle() : nullptr, -1, ZMQ_POLLIN, 0}};
     try {
-      zmq::poll(items, 2, poll_timeout(Clock::now()));
+      zmq::poll(items, zap_ ? 4 : 2, poll_timeout(Clock::now()));
       if (items[1].revents & ZMQ_POLLIN) shared_.wakeup.drain();
+      if (zap_ && (items[2].revents & ZMQ_POLLIN)) serve_zap();
+      if (monitor_ && (items[3].revents & ZMQ_POLLIN)) read_monitor();
       if (items[0].revents & ZMQ_POLLIN) receive_all();
     } catch (const zmq::error_t& e) {
       if (e.num() != EINTR) {
@@ -173,6 +194,81 @@ void Broker::Loop::shutdown() {
   } catch (const zmq::error_t&) {
   }
   router_.close();
+  if (monitor_) monitor_->close();
+  if (zap_) zap_->close();
+}
+
+// --- Loop: security -----------------------------------------------------------------
+
+// Before the bind: the ZAP handler must exist before the first handshake, or
+// libzmq would let the client in unchecked.
+void Broker::Loop::secure() {
+  if (!zmq_has("curve")) throw std::runtime_error("this libzmq has no CURVE support");
+  zap_.emplace(ctx_, zmq::socket_type::rep);
+  zap_->set(zmq::sockopt::linger, 0);
+  zap_->bind(kZapEndpoint);
+  router_.set(zmq::sockopt::curve_server, 1);
+  router_.set(zmq::sockopt::curve_secretkey, options_.curve_secret_key);
+  router_.set(zmq::sockopt::zap_domain, kZapDomain);
+  // ZAP denials are counted where they are decided; the monitor sees the
+  // handshakes that never reach ZAP (a client speaking another mechanism).
+  if (zmq_socket_monitor(router_.handle(), kMonitorEndpoint,
+                         ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL | ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) != 0)
+    throw zmq::error_t();
+  monitor_.emplace(ctx_, zmq::socket_type::pair);
+  monitor_->set(zmq::sockopt::linger, 0);
+  monitor_->connect(kMonitorEndpoint);
+}
+
+void Broker::Loop::auth_failed(const std::string& what) {
+  const auto n = ++shared_.auth_failures;
+  if (worth_logging(n)) log("broker: worker authentication failed: " + what + " (" + std::to_string(n) + " so far)");
+}
+
+// ZAP (RFC 27): [version, request id, domain, address, identity, mechanism,
+// credentials...] -> [version, request id, status code, status text, user id, metadata].
+void Broker::Loop::serve_zap() {
+  for (int i = 0; i < 1000; ++i) {
+    std::vector<zmq::message_t> request;
+    if (!zmq::recv_multipart(*zap_, std::back_inserter(request), zmq::recv_flags::dontwait)) return;
+    WorkerAuth::Decision decision{false, "malformed ZAP request"};
+    std::string address = "?", key;
+    if (request.size() >= 6 && request[0].to_string() == "1.0") {
+      address = request[3].to_string();
+      const std::string mechanism = request[5].to_string();
+      if (mechanism == "CURVE" && request.size() >= 7 && request[6].size() == 32) {
+        key = api::z85_encode_key(request[6].to_string());
+        decision = auth_.check(address, key, Clock::now());
+      } else {
+        decision.reason = "mechanism " + mechanism + " not accepted";
+        auth_.charge(address, Clock::now());
+      }
+    }
+    if (!decision.allowed) auth_failed(decision.reason + " (from " + address + ")");
+    const std::string id = request.size() > 1 ? request[1].to_string() : std::string();
+    const std::array<std::string, 6> reply = {"1.0", id, decision.allowed ? "200" : "400",
+                                              decision.allowed ? "OK" : decision.reason,
+                                              decision.allowed ? key : std::string(), ""};
+    try {
+      for (std::size_t f = 0; f < reply.size(); ++f)
+        zap_->send(zmq::buffer(reply[f]), f + 1 < reply.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    } catch (const zmq::error_t& e) {
+      log(std::string("broker: cannot answer a ZAP request: ") + e.what());
+    }
+  }
+}
+
+// Monitor events: [16-bit event, 32-bit value] [endpoint].
+void Broker::Loop::read_monitor() {
+  for (int i = 0; i < 1000; ++i) {
+    std::vector<zmq::message_t> event;
+    if (!zmq::recv_multipart(*monitor_, std::back_inserter(event), zmq::recv_flags::dontwait)) return;
+    if (event.empty() || event[0].size() < 6) continue;
+    std::uint16_t id = 0;
+    std::memcpy(&id, event[0].data(), sizeof id);
+    if (id == ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL) auth_failed("a client failed the CURVE handshake (wrong mechanism or key)");
+    else if (id == ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) auth_failed("a client's handshake failed");
+  }
 }
 
 // --- Loop: sending ----------------------------------------------------------------
@@ -217,13 +313,16 @@ void Broker::Loop::handle(std::vector<zmq::message_t>& parts) {
   frames.reserve(parts.size() - 1);
   for (std::size_t i = 1; i < parts.size(); ++i) frames.push_back(parts[i].to_string());
   const auto known = workers_.find(identity);
-  if (known != workers_.end()) known->second.expiry = Clock::now() + known->second.expiry_span;
+  if (known != workers_.end()) {
+    known->second.last_heard = Clock::now();
+    known->second.expiry = known->second.last_heard + known->second.expiry_span;
+  }
 
   std::string error;
   const std::optional<api::Message> message = api::try_decode(frames, &error);
   if (!message) {
     const auto n = ++shared_.malformed;
-    if (n <= 10 || (n & (n - 1)) == 0)
+    if (worth_logging(n))
       log("broker: dropped a malformed message from peer " + printable(identity) + ": " + error + " (" +
           std::to_string(n) + " so far)");
     return;
@@ -244,13 +343,17 @@ void Broker::Loop::handle_ready(const std::string& identity, const api::ReadyMsg
                          std::to_string(api::kProtocolVersion) + ")");
     return;
   }
-  if (!options_.token.empty() && !(ready.token && same_secret(options_.token, *ready.token))) {
-    refuse(identity, "unauthorized: wrong or missing token");
-    return;
+  // The token (if any) is not checked: the worker proved itself in the CURVE handshake.
+  if (const auto it = identity_of_.find(ready.id); it != identity_of_.end() && it->second != identity) {
+    const Worker& holder = workers_.at(it->second);
+    const auto interval = holder.expiry_span / std::max(1, options_.heartbeat_liveness);
+    if (Clock::now() - holder.last_heard < 2 * interval) {
+      refuse(identity, "worker id in use: " + ready.id);
+      return;
+    }
+    remove_worker(it->second, "reconnected", false);
   }
   if (workers_.count(identity)) remove_worker(identity, "sent READY again", false);
-  if (const auto it = identity_of_.find(ready.id); it != identity_of_.end())
-    remove_worker(it->second, "reconnected", false);
   register_worker(identity, ready);
 }
 
@@ -270,17 +373,35 @@ void Broker::Loop::handle_known(Worker& w, const api::Message& message) {
   }
 }
 
+// True when `u` is an attempt `w` holds (it leaves w's in-flight set);
+// otherwise the answer is refused and counted, and nothing changes.
+bool Broker::Loop::fenced(Worker& w, const api::UnitRef& u, const char* what) {
+  const auto it = w.in_flight.find(u.attempt);
+  if (it != w.in_flight.end() && it->second == key_of(u)) {
+    w.in_flight.erase(it);
+    return true;
+  }
+  if (it == w.in_flight.end() && w.cancelled.erase(u.attempt)) return false;  // cancelled here: a late answer
+  const auto n = ++shared_.results_refused;
+  if (worth_logging(n))
+    log(std::string("broker: refused a ") + what + " from worker " + w.id + " for attempt " +
+        std::to_string(u.attempt) + " (" + u.job + "/" + std::to_string(u.tile) + "/" + std::to_string(u.batch) + "/" +
+        std::to_string(u.pass) + "): " + (it == w.in_flight.end() ? "not sent to it" : "not the unit sent") + " (" +
+        std::to_string(n) + " so far)");
+  return false;
+}
+
 void Broker::Loop::handle_result(Worker& w, const api::ResultMsg& r) {
+  if (!fenced(w, r.unit, "RESULT")) return;
   ++shared_.results;
-  w.in_flight.erase(r.unit.attempt);
   guarded("unit_done", [&] {
     backend_.unit_done(w.id, key_of(r.unit), r.unit.attempt, api::payload_bytes(r.film_tile), r.paths);
   });
 }
 
 void Broker::Loop::handle_failed(Worker& w, const api::FailedMsg& f) {
+  if (!fenced(w, f.unit, "FAILED")) return;
   ++shared_.failures;
-  w.in_flight.erase(f.unit.attempt);
   log("broker: worker " + w.id + " failed unit " + f.unit.job + "/" + std::to_string(f.unit.tile) + "/" +
       std::to_string(f.unit.batch) + "/" + std::to_string(f.unit.pass) + ": " + f.message);
   guarded("unit_failed", [&] { backend_.unit_failed(w.id, key_of(f.unit), f.unit.attempt, f.message); });
@@ -306,7 +427,8 @@ void Broker::Loop::register_worker(const std::string& identity, const api::Ready
   w.id = ready.id;
   w.slots = ready.slots;
   w.expiry_span = expiry_span(ready.heartbeat_ms);
-  w.expiry = Clock::now() + w.expiry_span;
+  w.last_heard = Clock::now();
+  w.expiry = w.last_heard + w.expiry_span;
   workers_[identity] = w;
   identity_of_[ready.id] = identity;
   ++shared_.workers;
@@ -363,6 +485,8 @@ void Broker::Loop::send_cancels() {
     const std::string identity = i->second;
     Worker& w = workers_.at(identity);
     if (!w.in_flight.erase(attempt)) continue;  // already answered
+    if (w.cancelled.size() >= kMaxCancelledRemembered) w.cancelled.erase(w.cancelled.begin());
+    w.cancelled.insert(attempt);
     ++shared_.cancels_sent;
     send_or_lose(identity, api::CancelMsg{attempt});
   }
@@ -449,7 +573,7 @@ BrokerStats Broker::stats() const {
   return BrokerStats{s.workers.load(),    s.joined.load(),       s.left.load(),         s.lost.load(),
                      s.rejected.load(),   s.units_sent.load(),   s.results.load(),      s.failures.load(),
                      s.cancels_sent.load(), s.malformed.load(),  s.unexpected.load(),   s.reregisters_sent.load(),
-                     s.backend_errors.load()};
+                     s.backend_errors.load(), s.auth_failures.load(), s.results_refused.load()};
 }
 
 }  // namespace skyfarm::server

@@ -5,13 +5,24 @@
 //
 // Per worker (keyed by its ROUTER routing identity; its READY "id" is the
 // name the backend sees):
-//   handshake   READY (right version, right token when one is set) ->
+//   security    with curve_secret_key set the ROUTER is a CURVE server: every
+//               connection is authenticated by a ZAP handler (an inproc REP
+//               socket served on the broker thread) applying WorkerAuth
+//               (server/worker_auth.h) to the client's public key, and all
+//               traffic is encrypted.  Denials, and handshakes that fail
+//               because the client speaks another mechanism (NULL, PLAIN; seen
+//               through a socket monitor), count as auth_failures.  Without a
+//               key the NULL mechanism lets anyone in: for tests of the
+//               protocol only (skyfarm-server always sets one).
+//   handshake   READY (right version; its token is ignored) ->
 //               backend.worker_joined(id, header without the token) and an
-//               immediate HEARTBEAT; a wrong version or token gets a fatal
-//               DISCONNECT.  A READY whose id is already registered under
-//               another identity (a worker that reconnected) first ends the
-//               old registration (worker_left).  Any other message from an
-//               unknown peer is answered with REREGISTER.
+//               immediate HEARTBEAT; a wrong version gets a fatal
+//               DISCONNECT.  A READY whose id is registered under another
+//               identity is refused ("worker id in use", fatal) while that
+//               one is alive; once it has missed a heartbeat (silent for two
+//               of its intervals) the new READY ends it (worker_left) and takes
+//               its place: a worker that reconnected.  Any other message from
+//               an unknown peer is answered with REREGISTER.
 //   credit      the worker holds at most `slots` (its READY) units; a UNIT is
 //               sent only while it has a free slot (backend.next_unit), one
 //               unit per worker per round-robin round.  RESULT, FAILED and
@@ -25,9 +36,12 @@
 //               ROUTER_MANDATORY, or EAGAIN at the high-water mark: sends
 //               never block).
 //   results     RESULT -> backend.unit_done, FAILED -> backend.unit_failed,
-//               with the worker's (unit, attempt) as sent: results of stale
-//               or cancelled attempts are passed on (the backend drops
-//               them); the film-tile bytes are not decoded here.
+//               only for an attempt this broker sent to that worker (its
+//               in-flight set) with the same job, tile, batch and pass:
+//               anything else is refused (results_refused, logged) and never
+//               reaches the backend, and an attempt held by another worker
+//               stays with it.  The late answer of an attempt cancelled here
+//               is dropped silently.  The film-tile bytes are not decoded here.
 //   cancels     backend.take_cancelled_attempts() each tick -> CANCEL to the
 //               holders still connected (their slot is freed at once).
 //   timeouts    backend.check_timeouts(now) every timeout_check_interval.
@@ -49,6 +63,7 @@
 #include <thread>
 
 #include "server/job_service.h"
+#include "server/worker_auth.h"
 
 namespace skyfarm::server {
 
@@ -57,8 +72,11 @@ struct BrokerOptions {
   std::string endpoint = "tcp://127.0.0.1:5555";
   std::chrono::milliseconds heartbeat_interval{1000};
   int heartbeat_liveness = 3;  // missed intervals before a worker is declared lost
-  // Shared secret every READY must carry ("token"); empty: none required.
-  std::string token;
+  // The server's CURVE secret key (Z85); empty: the NULL mechanism (no
+  // authentication, no encryption: tests only).
+  std::string curve_secret_key;
+  // Which worker keys the ZAP handler lets in (used with curve_secret_key).
+  WorkerAuthOptions auth;
   // Longest wait in zmq_poll: the latency of stop(), of noticing cancels and
   // of dispatching work that appears without wake() (capped at heartbeat_interval).
   std::chrono::milliseconds poll_interval{20};
@@ -75,7 +93,7 @@ struct BrokerStats {
   std::uint64_t joined = 0;            // READY accepted
   std::uint64_t left = 0;              // worker_left calls (lost + disconnected)
   std::uint64_t lost = 0;              // of which: missed heartbeats or failed sends
-  std::uint64_t rejected = 0;          // READY refused (token, version)
+  std::uint64_t rejected = 0;          // READY refused (version, worker id in use)
   std::uint64_t units_sent = 0;
   std::uint64_t results = 0;
   std::uint64_t failures = 0;          // FAILED messages
@@ -84,6 +102,8 @@ struct BrokerStats {
   std::uint64_t unexpected = 0;        // valid messages a worker must not send (UNIT, CANCEL ...)
   std::uint64_t reregisters_sent = 0;
   std::uint64_t backend_errors = 0;    // exceptions thrown by the backend
+  std::uint64_t auth_failures = 0;     // CURVE handshakes denied or failed (incl. rate-limited)
+  std::uint64_t results_refused = 0;   // RESULT / FAILED for an attempt the worker was not sent
 };
 
 class Broker {

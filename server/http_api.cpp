@@ -475,7 +475,17 @@ void HttpApi::healthz(const Request&, Response& res) { send_json(res, 200, {{"st
 
 void HttpApi::metrics(const Request&, Response& res) {
   res.status = 200;
-  std::string text = prometheus_text(backend_.metrics(), responses_, open_streams());
+  nlohmann::json figures = backend_.metrics();
+  const nlohmann::json extra = options_.extra_metrics ? options_.extra_metrics() : nlohmann::json::object();
+  if (figures.is_object() && extra.is_object())  // the broker's counters; a shared name is summed
+    for (const auto& [key, value] : extra.items()) {
+      if (!value.is_number()) continue;
+      const auto it = figures.find(key);
+      if (it == figures.end() || !it->is_number()) figures[key] = value;
+      else if (it->is_number_unsigned() && value.is_number_unsigned()) *it = it->get<std::uint64_t>() + value.get<std::uint64_t>();
+      else *it = it->get<double>() + value.get<double>();
+    }
+  std::string text = prometheus_text(figures, responses_, open_streams());
   append_sky_cache_metrics(text, sky_->service().stats());
   if (options_.probes) append_probe_metrics(text, options_.probes->stats());
   res.set_content(std::move(text), kPrometheusContentType);

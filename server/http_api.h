@@ -95,6 +95,9 @@ struct HttpOptions {
   std::chrono::milliseconds probe_timeout = std::chrono::seconds(120);  // 504 beyond (server/http_probe.h)
   // The timelapses (not owned; must outlive the HttpApi); null: no /v1/timelapses routes.
   TimelapseService* timelapses = nullptr;
+  // More figures for /metrics (e.g. the broker's auth_failures, results_refused),
+  // added to the backend's (summed where both have one); may be empty.
+  std::function<nlohmann::json()> extra_metrics;
 };
 
 class HttpApi {

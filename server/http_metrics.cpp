@@ -26,6 +26,10 @@ constexpr KnownMetric kKnown[] = {
     {"samples_per_second", "skyfarm_samples_per_second", "gauge", "Samples merged per second, recent average."},
     {"unit_failures", "skyfarm_unit_failures_total", "counter", "Work units reported failed by workers."},
     {"requeues", "skyfarm_unit_requeues_total", "counter", "Work units requeued (lost worker, timeout, failure)."},
+    {"auth_failures", "skyfarm_worker_auth_failures_total", "counter",
+     "Worker CURVE handshakes denied or failed (unknown key, wrong mechanism, rate-limited address)."},
+    {"results_refused", "skyfarm_results_refused_total", "counter",
+     "Results refused: for an attempt not sent to that worker, or not matching the unit sent."},
 };
 constexpr std::string_view kJobsPrefix = "jobs_";
 

@@ -8,6 +8,9 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <string_view>
+
+extern char** environ;
 
 namespace skyfarm::server {
 
@@ -17,16 +20,29 @@ LocalWorkers::~LocalWorkers() { stop(); }
 
 pid_t LocalWorkers::spawn(int index) {
   const std::string threads = std::to_string(options_.threads_each);
-  const std::string id = "local-" + std::to_string(::getpid()) + "-" + std::to_string(index);
+  // A restarted worker gets a new id: the broker refuses an id whose holder
+  // has not yet missed its heartbeats, and the old process's may not have.
+  const int restarts = restarts_[index]++;
+  const std::string id = "local-" + std::to_string(::getpid()) + "-" + std::to_string(index) +
+                         (restarts > 0 ? "-r" + std::to_string(restarts) : "");
   std::vector<std::string> args = {options_.worker_binary, "--connect", options_.endpoint, "--threads", threads,
                                    "--id", id};
-  if (!options_.token.empty()) {
-    args.push_back("--token");
-    args.push_back(options_.token);
-  }
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
+  // Built before fork: the child of a threaded process may only exec.
+  std::vector<std::string> env;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string_view var(*e);
+    const bool credential = var.starts_with("SKYFARM_WORKER_SECRET") || var.starts_with("SKYFARM_KEY_FILE=") ||
+                            var.starts_with("SKYFARM_SERVER_KEY") || var.starts_with("SKYFARM_TOKEN=");
+    if (!credential) env.emplace_back(var);
+  }
+  if (!options_.worker_secret.empty()) env.push_back("SKYFARM_WORKER_SECRET=" + options_.worker_secret);
+  if (!options_.server_key.empty()) env.push_back("SKYFARM_SERVER_KEY=" + options_.server_key);
+  std::vector<char*> envp;
+  for (auto& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
   const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid == 0) {
@@ -34,7 +50,7 @@ pid_t LocalWorkers::spawn(int index) {
     // left behind knocking on a broker that no longer exists.
     ::prctl(PR_SET_PDEATHSIG, SIGTERM);
     if (::getppid() != parent) ::_exit(0);
-    ::execv(argv[0], argv.data());
+    ::execve(argv[0], argv.data(), envp.data());
     std::perror("skyfarm-server: cannot start the local worker");
     ::_exit(127);
   }

@@ -4,8 +4,13 @@
 // 30 s while it keeps failing).  stop() sends SIGTERM (workers drain their
 // units), waits up to 5 s, then SIGKILLs what is left.  Local workers get
 // SIGTERM when the server process dies, however it dies (PR_SET_PDEATHSIG).
+// Credentials travel in the environment, never argv (/proc/PID/cmdline is
+// world-readable, /proc/PID/environ is not): SKYFARM_WORKER_SECRET (the
+// shared worker secret) and SKYFARM_SERVER_KEY (the server's public key);
+// the server's own SKYFARM_* credential variables are not passed on.
 #pragma once
 #include <atomic>
+#include <map>
 #include <mutex>
 #include <string>
 #include <sys/types.h>
@@ -19,7 +24,8 @@ struct LocalWorkerOptions {
   std::string endpoint;       // the broker's bound endpoint
   int count = 0;
   int threads_each = 1;
-  std::string token;
+  std::string worker_secret;  // SKYFARM_WORKER_SECRET of every worker
+  std::string server_key;     // SKYFARM_SERVER_KEY (Z85 public key); empty: derived from the secret
 };
 
 class LocalWorkers {
@@ -38,6 +44,7 @@ class LocalWorkers {
   LocalWorkerOptions options_;
   mutable std::mutex mu_;
   std::vector<pid_t> pids_;
+  std::map<int, int> restarts_;  // per slot, guarded by mu_
   std::atomic<bool> stopping_{false};
   std::thread supervisor_;
 };

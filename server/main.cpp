@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <iostream>
 #include <thread>
 
+#include "api/curve_keys.h"
 #include "common/render/parallel.h"
 #include "server/broker.h"
 #include "server/http_api.h"
@@ -28,10 +30,72 @@ bool is_loopback(const std::string& host) {
   return host == "127.0.0.1" || host == "localhost" || host == "::1" || host.rfind("127.", 0) == 0;
 }
 
+// The broker's CURVE credentials and what the local workers get.
+struct WorkerCredentials {
+  skyfarm::api::CurveKeyPair server;
+  std::vector<std::string> allowed_keys;  // the key derived from the shared secret
+  std::string local_secret;               // handed to the local workers
+};
+
+// From the flags; throws std::runtime_error naming the flag (exit 2).
+WorkerCredentials worker_credentials(const skyfarm::server::ServerOptions& o) {
+  namespace api = skyfarm::api;
+  WorkerCredentials c;
+  std::string shared;
+  const std::string keys_dir = o.data_dir + "/keys";
+  if (!o.worker_secret_file.empty()) {
+    try {
+      shared = api::read_secret_file(o.worker_secret_file);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("--worker-secret-file: ") + e.what());
+    }
+  } else if (o.worker_keys.empty()) {
+    if (!api::is_loopback_endpoint(o.broker))
+      throw std::runtime_error("--broker " + o.broker +
+                               " is reachable beyond this machine: give --worker-secret-file PATH (a shared secret) "
+                               "or --worker-keys PATH (an allow-list of worker public keys) so that workers "
+                               "must authenticate");
+    try {
+      shared = api::ensure_secret_file(keys_dir + "/worker.secret");
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("cannot keep the worker secret under --data-dir: ") + e.what());
+    }
+  } else {
+    std::error_code ec;
+    if (!std::filesystem::exists(o.worker_keys, ec))
+      throw std::runtime_error("--worker-keys: " + o.worker_keys + ": no such file or folder");
+  }
+  if (!shared.empty()) {
+    c.allowed_keys.push_back(api::derive_worker_keys(shared).public_key);
+    c.local_secret = shared;
+  } else {  // allow-list only: the local workers get a secret of this run
+    c.local_secret = api::random_secret();
+    c.allowed_keys.push_back(api::derive_worker_keys(c.local_secret).public_key);
+  }
+  if (!o.server_key_file.empty()) {
+    try {
+      c.server = api::read_key_file(o.server_key_file);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("--server-key-file: ") + e.what());
+    }
+  } else if (!shared.empty()) {
+    c.server = api::derive_server_keys(shared);
+  } else {  // an allow-list without a server key: one made once, kept with the data
+    const std::string path = keys_dir + "/server.key";
+    std::error_code ec;
+    std::filesystem::create_directories(keys_dir, ec);
+    if (!std::filesystem::exists(path, ec)) api::write_key_pair(path, api::generate_curve_keys());
+    c.server = api::read_key_file(path);
+  }
+  return c;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace skyfarm::server;
+  if (argc >= 2 && std::string(argv[1]) == "keygen")
+    return skyfarm::api::run_keygen_command("skyfarm-server", {argv + 2, argv + argc});
   ServerOptions options;
   if (const std::string err = parse_server_options({argv + 1, argv + argc}, &options); !err.empty()) {
     std::cerr << "skyfarm-server: " << err << "\n" << kServerUsage;
@@ -53,6 +117,13 @@ int main(int argc, char** argv) {
   if (options.token.empty() && !is_loopback(host)) {
     std::cerr << "skyfarm-server: refusing to listen on " << host
               << " without --token (loopback only unless a token protects the API)\n";
+    return 2;
+  }
+  WorkerCredentials credentials;
+  try {
+    credentials = worker_credentials(options);
+  } catch (const std::exception& e) {
+    std::cerr << "skyfarm-server: " << e.what() << "\n";
     return 2;
   }
   struct sigaction sa {};
@@ -79,9 +150,13 @@ int main(int argc, char** argv) {
 
     BrokerOptions broker_options;
     broker_options.endpoint = options.broker;
-    broker_options.token = options.token;
+    broker_options.curve_secret_key = credentials.server.secret_key;
+    broker_options.auth.allowed_keys = credentials.allowed_keys;
+    broker_options.auth.keys_path = options.worker_keys;
     Broker broker(router, broker_options);
     broker.start();
+    std::cout << "skyfarm-server: workers authenticate with CURVE; server public key "
+              << credentials.server.public_key << std::endl;
 
     HttpOptions http_options;
     if (!options.token.empty()) http_options.token = options.token;
@@ -93,6 +168,10 @@ int main(int argc, char** argv) {
     sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
     http_options.sky = std::make_shared<SkyService>(sky);
     http_options.timelapses = &timelapses;
+    http_options.extra_metrics = [&broker] {
+      const BrokerStats s = broker.stats();
+      return nlohmann::json{{"auth_failures", s.auth_failures}, {"results_refused", s.results_refused}};
+    };
     HttpApi api(service, http_options);
     httplib::Server http;
     api.register_routes(http);
@@ -109,7 +188,8 @@ int main(int argc, char** argv) {
     local.worker_binary = options.worker_binary.empty() ? find_worker_binary(argv[0]) : options.worker_binary;
     local.endpoint = broker.bound_endpoint();
     local.count = options.local_workers < 0 ? skyfarm::resolve_thread_count(0) : options.local_workers;
-    local.token = options.token;
+    local.worker_secret = credentials.local_secret;
+    local.server_key = credentials.server.public_key;
     LocalWorkers workers(local);
     workers.start();
 

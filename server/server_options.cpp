@@ -9,17 +9,26 @@ const char* const kServerUsage =
     "usage: skyfarm-server [--listen 127.0.0.1:8080] [--broker tcp://127.0.0.1:5555]\n"
     "                      [--local-workers N (default: cores; 0 = none)] [--data-dir ./skyfarm-data]\n"
     "                      [--token SECRET] [--worker-binary PATH] [--unit-timeout SECONDS]\n"
+    "                      [--worker-secret-file PATH] [--worker-keys FILE|DIR] [--server-key-file PATH]\n"
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
     "                      [--probe-timeout SECONDS (default 120)] [--sky-cache-mb N (default 256)]\n"
     "                      [--envmap-cache-mb N (default 128)] [--ffmpeg PATH] [--max-timelapse-frames N]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
+    "SKYFARM_WORKER_SECRET_FILE, SKYFARM_WORKER_KEYS, SKYFARM_SERVER_KEY_FILE,\n"
     "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT,\n"
     "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB, SKYFARM_FFMPEG, SKYFARM_MAX_TIMELAPSE_FRAMES).\n"
     "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
     "--sky-cache-mb, --envmap-cache-mb: MiB of LUT sky tables and of encoded env maps kept in memory\n"
     "for GET /v1/sky and /v1/sky/envmap.exr (least recently used evicted first; 0 keeps none).\n"
-    "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
+    "Without a token the server listens on loopback only; give --token to listen beyond it.\n"
+    "Workers authenticate with CURVE (the --token is for HTTP only): --worker-secret-file PATH (a shared\n"
+    "secret, never sent; workers give --secret-file) and/or --worker-keys FILE|DIR (an allow-list of\n"
+    "worker public keys from `skyfarm-worker keygen`, re-read when it changes); --server-key-file PATH\n"
+    "(from `skyfarm-server keygen PATH`) is the server's own key pair.  A --broker beyond loopback needs\n"
+    "one of the first two; on loopback without them the server keeps its own secret in\n"
+    "<data-dir>/keys/worker.secret (mode 0600) for `skyfarm-worker --secret-file`.\n"
+    "skyfarm-server keygen PATH writes a key pair: PATH (secret, 0600) and PATH.pub (public, Z85).\n";
 
 namespace {
 
@@ -32,6 +41,9 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--local-workers", "SKYFARM_LOCAL_WORKERS"},
                            {"--data-dir", "SKYFARM_DATA_DIR"},
                            {"--token", "SKYFARM_TOKEN"},
+                           {"--worker-secret-file", "SKYFARM_WORKER_SECRET_FILE"},
+                           {"--worker-keys", "SKYFARM_WORKER_KEYS"},
+                           {"--server-key-file", "SKYFARM_SERVER_KEY_FILE"},
                            {"--worker-binary", "SKYFARM_WORKER_BINARY"},
                            {"--unit-timeout", "SKYFARM_UNIT_TIMEOUT"},
                            {"--max-active-jobs", "SKYFARM_MAX_ACTIVE_JOBS"},
@@ -95,6 +107,12 @@ std::string set(const std::string& flag, const std::string& value, ServerOptions
       o->data_dir = value;
     } else if (flag == "--token") {
       o->token = value;
+    } else if (flag == "--worker-secret-file") {
+      o->worker_secret_file = value;
+    } else if (flag == "--worker-keys") {
+      o->worker_keys = value;
+    } else if (flag == "--server-key-file") {
+      o->server_key_file = value;
     } else if (flag == "--worker-binary") {
       o->worker_binary = value;
     } else if (flag == "--unit-timeout") {

@@ -3,7 +3,17 @@
 //   --broker tcp://127.0.0.1:5555  ZeroMQ ROUTER endpoint (SKYFARM_BROKER)
 //   --local-workers N           local worker processes, default: cores; 0 = none (SKYFARM_LOCAL_WORKERS)
 //   --data-dir ./skyfarm-data   jobs, tiles and images   (SKYFARM_DATA_DIR)
-//   --token SECRET              bearer token for /v1 and shared secret for workers (SKYFARM_TOKEN)
+//   --token SECRET              bearer token for /v1 (SKYFARM_TOKEN); not a worker credential
+//   --worker-secret-file PATH   shared worker secret; both ends derive CURVE keys from it, it never
+//                               goes on the wire (SKYFARM_WORKER_SECRET_FILE)
+//   --worker-keys PATH          allow-list of worker public keys (Z85): a file, one per line (# comments),
+//                               or a folder of *.pub; re-read when it changes (SKYFARM_WORKER_KEYS)
+//   --server-key-file PATH      the server's CURVE key pair from `skyfarm-server keygen PATH`; default:
+//                               derived from the worker secret, or <data-dir>/keys/server.key made once
+//                               (SKYFARM_SERVER_KEY_FILE)
+//                               A --broker beyond loopback needs --worker-secret-file or --worker-keys
+//                               (else exit 2); on loopback without either the server makes a secret
+//                               once, in <data-dir>/keys/worker.secret (0600), for hand-started workers.
 //   --worker-binary PATH        skyfarm-worker to start  (SKYFARM_WORKER_BINARY)
 //   --unit-timeout S            requeue a unit after S seconds without a result (SKYFARM_UNIT_TIMEOUT)
 //   --max-active-jobs N         queued + running jobs before 429 (SKYFARM_MAX_ACTIVE_JOBS)
@@ -31,6 +41,9 @@ struct ServerOptions {
   int local_workers = -1;  // -1: one per core
   std::string data_dir = "./skyfarm-data";
   std::string token;
+  std::string worker_secret_file;
+  std::string worker_keys;
+  std::string server_key_file;
   std::string worker_binary;
   double unit_timeout_s = 120.0;
   int max_active_jobs = 64;

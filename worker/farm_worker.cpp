@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <condition_variable>
+#include <cstring>
+#include <optional>
 #include <cstdio>
 #include <deque>
 #include <iostream>
@@ -214,7 +216,7 @@ struct FarmWorker::Impl {
   api::WakeupPipe wakeup;
   struct Counters {
     std::atomic<std::uint64_t> sessions{0}, units_received{0}, results_sent{0}, failures_sent{0},
-        cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0};
+        cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0}, auth_failures{0};
   } counters;
 
  private:
@@ -233,6 +235,11 @@ struct FarmWorker::Impl {
   api::HeartbeatMsg heartbeat() const;
   void log(const std::string& line) const;
 
+  std::optional<zmq::socket_t> watch_handshakes(zmq::context_t& ctx, zmq::socket_t& socket);
+  void read_monitor();
+
+  zmq::socket_t* monitor_ = nullptr;  // handshake failures of the session's socket
+  std::uint64_t monitor_count_ = 0;
   std::unique_ptr<RenderPool> pool_;
   std::uint64_t session_ = 0;                      // abandons renders of earlier sessions
   std::map<std::uint64_t, api::UnitRef> units_;  // attempt -> unit held in this session
@@ -265,11 +272,20 @@ int FarmWorker::Impl::run() {
     zmq::socket_t socket(ctx, zmq::socket_type::dealer);
     socket.set(zmq::sockopt::linger, 0);
     socket.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64) << 20);
+    std::optional<zmq::socket_t> monitor;
+    if (!options.server_key.empty()) {
+      socket.set(zmq::sockopt::curve_serverkey, options.server_key);
+      socket.set(zmq::sockopt::curve_publickey, options.public_key);
+      socket.set(zmq::sockopt::curve_secretkey, options.secret_key);
+      monitor = watch_handshakes(ctx, socket);
+    }
+    monitor_ = monitor ? &*monitor : nullptr;
     socket.connect(options.endpoint);
     const SessionEnd end = serve(socket);
     if (end == SessionEnd::kDrained && heard_server_)  // let the results and DISCONNECT leave
       socket.set(zmq::sockopt::linger, static_cast<int>(options.drain_linger.count()));
     socket.close();
+    monitor_ = nullptr;
     if (end == SessionEnd::kDrained) break;
     if (end == SessionEnd::kRefused) {
       rc = 1;
@@ -314,14 +330,17 @@ SessionEnd FarmWorker::Impl::serve(zmq::socket_t& socket) {
       std::this_thread::sleep_for(Ms(10));
       continue;
     }
-    zmq::pollitem_t items[] = {{socket.handle(), 0, ZMQ_POLLIN, 0}, {nullptr, wakeup.read_fd(), ZMQ_POLLIN, 0}};
+    zmq::pollitem_t items[] = {{socket.handle(), 0, ZMQ_POLLIN, 0},
+                               {nullptr, wakeup.read_fd(), ZMQ_POLLIN, 0},
+                               {monitor_ ? monitor_->handle() : nullptr, -1, ZMQ_POLLIN, 0}};
     const auto to_heartbeat = std::chrono::duration_cast<Ms>(next_heartbeat_ - Clock::now());
     try {
-      zmq::poll(items, 2, std::clamp(to_heartbeat, Ms(0), kMaxTick));
+      zmq::poll(items, monitor_ ? 3 : 2, std::clamp(to_heartbeat, Ms(0), kMaxTick));
     } catch (const zmq::error_t& e) {
       if (e.num() != EINTR) throw;
     }
     if (items[1].revents & ZMQ_POLLIN) wakeup.drain();
+    if (monitor_ && (items[2].revents & ZMQ_POLLIN)) read_monitor();
     for (int i = 0; i < 1000; ++i) {  // bounded: heartbeats must go out whatever arrives
       const std::optional<api::Message> message = receive(socket);
       if (!message) break;
@@ -384,6 +403,36 @@ void FarmWorker::Impl::send_ready(zmq::socket_t& socket) {
   const auto now = Clock::now();
   server_expiry_ = now + server_span_;
   next_heartbeat_ = now + options.heartbeat_interval;
+}
+
+// A PAIR socket receiving the socket's handshake failures (its own inproc
+// endpoint per session, so an old session's events never mix in).
+std::optional<zmq::socket_t> FarmWorker::Impl::watch_handshakes(zmq::context_t& ctx, zmq::socket_t& socket) {
+  const std::string endpoint = "inproc://skyfarm-worker-monitor-" + std::to_string(++monitor_count_);
+  if (zmq_socket_monitor(socket.handle(), endpoint.c_str(),
+                         ZMQ_EVENT_HANDSHAKE_FAILED_AUTH | ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
+                             ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) != 0)
+    return std::nullopt;
+  zmq::socket_t monitor(ctx, zmq::socket_type::pair);
+  monitor.set(zmq::sockopt::linger, 0);
+  monitor.connect(endpoint);
+  return monitor;
+}
+
+void FarmWorker::Impl::read_monitor() {
+  for (;;) {
+    std::vector<zmq::message_t> event;
+    if (!zmq::recv_multipart(*monitor_, std::back_inserter(event), zmq::recv_flags::dontwait)) return;
+    if (event.empty() || event[0].size() < 6) continue;
+    std::uint16_t id = 0;
+    std::memcpy(&id, event[0].data(), sizeof id);
+    const auto n = ++counters.auth_failures;
+    if (n > 3 && (n & (n - 1)) != 0) continue;  // the first ones, then every power of two
+    log("worker " + options.id + ": the server refused the CURVE handshake (" +
+        (id == ZMQ_EVENT_HANDSHAKE_FAILED_AUTH ? std::string("our key is not allowed")
+                                               : std::string("wrong server key or mechanism")) +
+        "; check --secret-file / --key-file / --server-key; " + std::to_string(n) + " so far)");
+  }
 }
 
 // The server requeues what we held: forget it (renders in progress finish unseen).
@@ -484,7 +533,7 @@ FarmWorkerStats FarmWorker::stats() const {
   const auto& c = impl_->counters;
   return FarmWorkerStats{c.sessions.load(),         c.units_received.load(),  c.results_sent.load(),
                          c.failures_sent.load(),    c.cancels_received.load(), c.results_dropped.load(),
-                         c.malformed.load(),        c.send_failures.load()};
+                         c.malformed.load(),        c.send_failures.load(),     c.auth_failures.load()};
 }
 
 void FarmWorker::set_paused_for_testing(bool paused) {

@@ -36,7 +36,11 @@
 //   (reconnect_initial doubling to reconnect_max, reset once the server
 //   answers) a new socket connects and sends READY again.  REREGISTER (the
 //   server forgot us) abandons the session's units and sends READY at once.
-//   A fatal DISCONNECT (wrong token, protocol version) ends run() with 1.
+//   A fatal DISCONNECT (protocol version, worker id in use) ends run() with 1.
+// Security: with server_key set the socket is a CURVE client (encrypted,
+//   authenticated by the server's key; the server checks ours).  A server
+//   that denies our key is never heard from: the worker logs why (socket
+//   monitor) and keeps retrying with its back-off.
 // Drain (request_drain(), or *drain_flag set by a SIGTERM handler): the
 //   worker heartbeats "draining" so the server sends no more units, finishes
 //   the units it holds, sends their results, then DISCONNECT, and run()
@@ -58,7 +62,12 @@ struct FarmWorkerOptions {
   std::string endpoint = "tcp://127.0.0.1:5555";
   int threads = 0;     // render threads; 0 = all hardware threads
   int slots = 0;       // units held at once (credit); 0 = threads + 1
-  std::string token;   // shared secret sent in READY (empty: none)
+  std::string token;   // sent inside READY for older servers; no longer a credential (the broker ignores it)
+  // CURVE (api/curve_keys.h): the server's public key and this worker's key
+  // pair, Z85; server_key empty: the NULL mechanism (tests of the protocol only).
+  std::string server_key;
+  std::string public_key;
+  std::string secret_key;
   std::string id;      // empty: hostname-pid-random
   std::chrono::milliseconds heartbeat_interval{1000};
   int heartbeat_liveness = 3;  // missed intervals before the server is declared lost
@@ -83,6 +92,7 @@ struct FarmWorkerStats {
   std::uint64_t results_dropped = 0;  // cancelled or abandoned units finished anyway
   std::uint64_t malformed = 0;        // undecodable or unexpected messages from the server
   std::uint64_t send_failures = 0;    // messages the socket would not queue
+  std::uint64_t auth_failures = 0;    // CURVE handshakes the server refused or that failed
 };
 
 class FarmWorker {
@@ -113,10 +123,16 @@ class FarmWorker {
 std::string default_worker_id();
 
 // `skyfarm-worker [--connect URL] [--threads N] [--slots N] [--token SECRET]
-// [--id NAME]`, each flag also read from SKYFARM_CONNECT, SKYFARM_THREADS,
-// SKYFARM_SLOTS, SKYFARM_TOKEN, SKYFARM_ID (a flag wins over its variable).
-// Installs the SIGTERM/SIGINT handlers (signals.h) and runs a FarmWorker;
-// returns its exit code (2 for bad arguments).
+// [--id NAME] [--secret-file PATH] [--key-file PATH] [--server-key KEY|PATH]`,
+// each flag also read from SKYFARM_CONNECT, SKYFARM_THREADS, SKYFARM_SLOTS,
+// SKYFARM_TOKEN, SKYFARM_ID, SKYFARM_WORKER_SECRET_FILE, SKYFARM_KEY_FILE,
+// SKYFARM_SERVER_KEY (a flag wins over its variable); SKYFARM_WORKER_SECRET
+// holds the secret itself (it wins over a secret file).  Credentials
+// (kFarmWorkerUsage): a key file wins for our own key pair, else the secret's
+// derived pair; the server key is --server-key, else derived from the secret.
+// With none, on a loopback endpoint, ./skyfarm-data/keys/worker.secret if
+// readable.  Installs the SIGTERM/SIGINT handlers (signals.h) and runs a
+// FarmWorker; returns its exit code (2 for bad arguments or no credential).
 int run_farm_worker_command(const std::vector<std::string>& args);
 extern const char* const kFarmWorkerUsage;
 

@@ -1,5 +1,5 @@
 // skyfarm-worker: the worker side of skyfarm.
-//   skyfarm-worker [--connect tcp://HOST:PORT] [--threads N] [--slots N] [--token SECRET]
+//   skyfarm-worker [--connect tcp://HOST:PORT] [--threads N] [--slots N] [--secret-file PATH] ...
 //                  the farm worker (the default mode: no command, or a first argument
 //                  starting with "--"); each flag also reads SKYFARM_<FLAG>
 //   skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png] [--threads N]
@@ -7,6 +7,7 @@
 //   skyfarm-worker demo [DIR]
 //   skyfarm-worker bench [paths|demo|memory|all] [--repeat N]
 //   skyfarm-worker info REQUEST.json [--json]   the request's sun and optical depths
+//   skyfarm-worker keygen PATH                  a CURVE key pair (PATH, PATH.pub)
 //   skyfarm-worker --help | --version
 #include <cstdio>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "api/curve_keys.h"
 #include "api/field_error.h"
 #include "api/render_request.h"
 #include "worker/bench_command.h"
@@ -43,6 +45,8 @@ constexpr const char* kUsage =
     "                                the renderer's benchmarks, JSON lines on stdout\n"
     "  info REQUEST.json [--json]   sun position and optical depths of a render request\n"
     "                                (REQUEST.json may be '-' for standard input)\n"
+    "  keygen PATH                   write a CURVE key pair for --key-file: PATH (the secret\n"
+    "                                key, mode 0600) and PATH.pub (the public key, Z85)\n"
     "\n"
     "options:\n"
     "  --help      this text\n"
@@ -103,6 +107,7 @@ int main(int argc, char** argv) {
     return 0;
   }
   if (args.empty() || args[0].rfind("--", 0) == 0) return skyfarm::run_farm_worker_command(args);
+  if (args[0] == "keygen") return skyfarm::api::run_keygen_command("skyfarm-worker", {args.begin() + 1, args.end()});
   const std::string command = args[0];
   args.erase(args.begin());
   if (command == "info") return run_info(args);

@@ -81,8 +81,8 @@ TEST(Farm, KilledWorkerLosesNothing) {
   const fs::path dir = fresh_dir("kill");
   FarmServer server(dir / "data", 0);
   ASSERT_TRUE(server.ok()) << server.log();
-  const pid_t a = testing::start_worker(server.endpoint(), dir / "a.log");
-  const pid_t b = testing::start_worker(server.endpoint(), dir / "b.log");
+  const pid_t a = testing::start_worker(server, dir / "a.log");
+  const pid_t b = testing::start_worker(server, dir / "b.log");
   const std::string id = server.submit(kRequest);
   ASSERT_FALSE(id.empty());
   // Wait until the job is under way, then SIGKILL one worker.
@@ -99,13 +99,13 @@ TEST(Farm, HungWorkerUnitsAreRequeued) {
   const fs::path dir = fresh_dir("hung");
   FarmServer server(dir / "data", 0);
   ASSERT_TRUE(server.ok()) << server.log();
-  const pid_t hung = testing::start_worker(server.endpoint(), dir / "hung.log");
+  const pid_t hung = testing::start_worker(server, dir / "hung.log");
   const std::string id = server.submit(kRequest);
   ASSERT_FALSE(id.empty());
   for (int i = 0; i < 200 && server.status(id)["state"] != "running"; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   ::kill(hung, SIGSTOP);  // alive but silent: no heartbeats, no results
-  const pid_t healthy = testing::start_worker(server.endpoint(), dir / "healthy.log");
+  const pid_t healthy = testing::start_worker(server, dir / "healthy.log");
   const auto status = server.wait(id, std::chrono::seconds(90));
   ::kill(hung, SIGCONT);
   testing::kill_and_wait(hung, SIGKILL);

@@ -55,7 +55,8 @@ class FarmServer {
  public:
   FarmServer(const std::filesystem::path& data_dir, int local_workers, const std::string& broker = "tcp://127.0.0.1:*",
              std::vector<std::string> extra = {})
-      : log_(data_dir.parent_path() / (data_dir.filename().string() + "-server-" + std::to_string(next_log_index()) + ".log")) {
+      : secret_file_(data_dir / "keys" / "worker.secret"),
+        log_(data_dir.parent_path() / (data_dir.filename().string() + "-server-" + std::to_string(next_log_index()) + ".log")) {
     std::filesystem::remove(log_);  // never read an older server's first line
     std::vector<std::string> args = {SKYFARM_SERVER_BINARY, "--listen", "127.0.0.1:0", "--broker", broker,
                                      "--local-workers", std::to_string(local_workers), "--data-dir", data_dir.string(),
@@ -85,6 +86,8 @@ class FarmServer {
   bool ok() const { return port_ > 0; }
   int port() const { return port_; }
   const std::string& endpoint() const { return endpoint_; }
+  // The worker secret a loopback server without credential flags keeps.
+  const std::filesystem::path& secret_file() const { return secret_file_; }
   pid_t pid() const { return pid_; }
   std::string log() const { return read_text(log_); }
   void kill_now() {
@@ -133,21 +136,18 @@ class FarmServer {
   }
 
  private:
+  std::filesystem::path secret_file_;
   std::filesystem::path log_;
   pid_t pid_ = 0;
   int port_ = 0;
   std::string endpoint_;
 };
 
-// An external skyfarm-worker process (a "second machine").
-inline pid_t start_worker(const std::string& endpoint, const std::filesystem::path& log, int threads = 1,
-                          const std::string& token = "") {
-  std::vector<std::string> args = {SKYFARM_WORKER_BINARY, "--connect", endpoint, "--threads", std::to_string(threads)};
-  if (!token.empty()) {
-    args.push_back("--token");
-    args.push_back(token);
-  }
-  return spawn_process(args, log);
+// An external skyfarm-worker process (a "second machine") with the server's worker secret.
+inline pid_t start_worker(const FarmServer& server, const std::filesystem::path& log, int threads = 1) {
+  return spawn_process({SKYFARM_WORKER_BINARY, "--connect", server.endpoint(), "--threads", std::to_string(threads),
+                        "--secret-file", server.secret_file().string()},
+                       log);
 }
 
 }  // namespace skyfarm::testing

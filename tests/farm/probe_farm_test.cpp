@@ -94,8 +94,8 @@ TEST(ProbeFarm, KilledWorkerLosesNothing) {
   const fs::path dir = fresh_dir("kill");
   FarmServer server(dir / "data", 0);
   ASSERT_TRUE(server.ok()) << server.log();
-  const pid_t a = testing::start_worker(server.endpoint(), dir / "a.log");
-  const pid_t b = testing::start_worker(server.endpoint(), dir / "b.log");
+  const pid_t a = testing::start_worker(server, dir / "a.log");
+  const pid_t b = testing::start_worker(server, dir / "b.log");
   auto client = server.client();
   for (int i = 0; i < 200; ++i) {  // both joined
     const auto res = client.Get("/v1/workers");

@@ -6,6 +6,10 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 #include "tests/server/fake_broker_backend.h"
@@ -75,12 +79,10 @@ TEST_F(BrokerTest, BindsAWildcardPortAndStopsQuickly) {
 }
 
 TEST_F(BrokerTest, ReadyJoinsTheWorkerWithoutItsToken) {
-  BrokerOptions o = test_options();
-  o.token = "s3cret";
-  start(o);
+  start();
   auto p = peer();
   api::ReadyMsg r = RawPeer::ready("w1", 3);
-  r.token = "s3cret";
+  r.token = "anything";  // no longer a credential: ignored
   p->send(r);
   ASSERT_TRUE(p->receive_a<api::HeartbeatMsg>());
   ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.joined.size() == 1; }));
@@ -97,28 +99,18 @@ TEST_F(BrokerTest, ReadyJoinsTheWorkerWithoutItsToken) {
   EXPECT_EQ(broker_->stats().workers, 1u);
 }
 
-TEST_F(BrokerTest, WrongTokenOrVersionIsRefusedWithAFatalDisconnect) {
-  BrokerOptions o = test_options();
-  o.token = "s3cret";
-  start(o);
+TEST_F(BrokerTest, WrongVersionIsRefusedWithAFatalDisconnect) {
+  start();
   auto p = peer();
   api::ReadyMsg r = RawPeer::ready("w1");
-  r.token = "guess";
+  r.version = api::kProtocolVersion + 1;
   p->send(r);
   auto bye = p->receive_a<api::DisconnectMsg>();
   ASSERT_TRUE(bye);
   EXPECT_TRUE(bye->fatal);
-  r.token.reset();
-  p->send(r);
-  ASSERT_TRUE(p->receive_a<api::DisconnectMsg>());
-  r.token = "s3cret";
-  r.version = api::kProtocolVersion + 1;
-  p->send(r);
-  bye = p->receive_a<api::DisconnectMsg>();
-  ASSERT_TRUE(bye);
   EXPECT_NE(bye->reason.find("version"), std::string::npos);
-  EXPECT_EQ(broker_->stats().rejected, 3u);
-  EXPECT_TRUE(backend_.with_lock([](auto& b) { return b.joined.empty(); }));
+  EXPECT_EQ(broker_->stats().rejected, 1u);
+  EXPECT_EQ(broker_->stats().workers, 0u);
 }
 
 TEST_F(BrokerTest, UnknownPeerIsAskedToReregister) {
@@ -212,22 +204,53 @@ TEST_F(BrokerTest, HeartbeatingWorkerStaysAndIsHeartbeated) {
   EXPECT_TRUE(backend_.with_lock([](auto& b) { return b.left.empty(); }));
 }
 
-TEST_F(BrokerTest, StaleAttemptResultsReachTheBackendWithTheirIds) {
+TEST_F(BrokerTest, ResultsForAttemptsNotSentToTheWorkerAreRefused) {
+  start();
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  backend_.add_unit("j", 1, 0, 0, "{}");
+  auto a = joined_peer("w1", 1);
+  auto ua = a->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(ua);
+  auto b = joined_peer("w2", 1);
+  auto ub = b->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(ub);
+  // w2 answers w1's attempt, an attempt nobody holds, and its own attempt with another tile.
+  b->send(api::ResultMsg{ua->unit, 1, 0.1, "forged"});
+  api::UnitRef unknown = ub->unit;
+  unknown.attempt += 100;
+  b->send(api::FailedMsg{unknown, "forged"});
+  api::UnitRef other_tile = ub->unit;
+  other_tile.tile = ua->unit.tile;
+  b->send(api::ResultMsg{other_tile, 1, 0.1, "forged"});
+  ASSERT_TRUE(eventually([&] { return broker_->stats().results_refused == 3; }));
+  // Nothing reached the backend, and each attempt stays with its holder.
+  a->send(api::ResultMsg{ua->unit, 1, 0.1, "a"});
+  b->send(api::ResultMsg{ub->unit, 1, 0.1, "b"});
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() == 2; }));
+  backend_.with_lock([&](auto& f) {
+    EXPECT_TRUE(f.failed.empty());
+    for (const auto& d : f.done) {
+      EXPECT_EQ(d.worker, d.attempt == ua->unit.attempt ? "w1" : "w2");
+      EXPECT_EQ(std::string(d.bytes.begin(), d.bytes.end()), d.worker == "w1" ? "a" : "b");
+    }
+    return 0;
+  });
+  EXPECT_EQ(broker_->stats().results_refused, 3u);
+  EXPECT_EQ(broker_->stats().results, 2u);
+}
+
+TEST_F(BrokerTest, TheLateAnswerOfACancelledAttemptIsDroppedNotRefused) {
   start();
   backend_.add_unit("j", 0, 0, 0, "{}");
   auto p = joined_peer("w1", 1);
   auto u = p->receive_a<api::UnitMsg>();
   ASSERT_TRUE(u);
-  api::UnitRef stale = u->unit;
-  stale.attempt += 100;
-  p->send(api::ResultMsg{stale, 1, 0.1, "old"});
-  p->send(api::ResultMsg{u->unit, 1, 0.1, "new"});
-  ASSERT_TRUE(backend_.wait_for([](auto& b) { return b.done.size() == 2; }));
-  backend_.with_lock([&](auto& b) {
-    EXPECT_EQ(b.done[0].attempt, stale.attempt);
-    EXPECT_EQ(b.done[1].attempt, u->unit.attempt);
-    return 0;
-  });
+  backend_.cancel(u->unit.attempt);
+  ASSERT_TRUE(p->receive_a<api::CancelMsg>());
+  p->send(api::ResultMsg{u->unit, 1, 0.1, "late"});
+  p->send(api::ResultMsg{u->unit, 1, 0.1, "again"});  // the second one is a refusal
+  ASSERT_TRUE(eventually([&] { return broker_->stats().results_refused == 1; }));
+  EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.done.empty(); }));
 }
 
 TEST_F(BrokerTest, CancelReachesTheHolderAndFreesItsSlot) {
@@ -269,12 +292,148 @@ TEST_F(BrokerTest, DrainingWorkerGetsNoMoreUnits) {
 TEST_F(BrokerTest, DisconnectAndReconnectWithTheSameIdReplaceTheRegistration) {
   start();
   auto a = joined_peer("w1", 1);
+  a->send(api::DisconnectMsg{});
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.left.size() == 1; }));
   auto b = joined_peer("w1", 1);  // the same worker on a new socket
-  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.joined.size() == 2 && f.left.size() == 1; }));
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.joined.size() == 2; }));
   EXPECT_EQ(broker_->stats().workers, 1u);
   b->send(api::DisconnectMsg{});
   ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.left.size() == 2; }));
   EXPECT_EQ(broker_->stats().workers, 0u);
+}
+
+TEST_F(BrokerTest, ALiveWorkersIdCannotBeTakenOver) {
+  BrokerOptions o = test_options();
+  o.heartbeat_liveness = 20;
+  start(o);
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  // The holder heartbeats every 500 ms: it has missed one after 1 s of silence
+  // (and would expire after 10 s), so a loaded machine cannot make it look dead.
+  auto a = peer();
+  api::ReadyMsg holder = RawPeer::ready("w1", 1);
+  holder.heartbeat_ms = 500;
+  a->send(holder);
+  ASSERT_TRUE(a->receive_a<api::HeartbeatMsg>());
+  auto u = a->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  auto thief = peer();
+  thief->send(RawPeer::ready("w1", 1));
+  auto bye = thief->receive_a<api::DisconnectMsg>();
+  ASSERT_TRUE(bye);
+  EXPECT_TRUE(bye->fatal);
+  EXPECT_NE(bye->reason.find("in use"), std::string::npos) << bye->reason;
+  // The holder keeps its registration and its unit.
+  a->send(api::ResultMsg{u->unit, 1, 0.1, "tile"});
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() == 1; }));
+  backend_.with_lock([](auto& f) {
+    EXPECT_TRUE(f.left.empty());
+    EXPECT_EQ(f.joined.size(), 1u);
+    EXPECT_EQ(f.done[0].worker, "w1");
+    return 0;
+  });
+  EXPECT_EQ(broker_->stats().rejected, 1u);
+  // Once the holder has missed heartbeats, the id may be claimed again (a reconnect).
+  std::this_thread::sleep_for(1200ms);
+  auto again = joined_peer("w1", 1);
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.joined.size() == 2 && f.left.size() == 1; }));
+}
+
+// --- CURVE -------------------------------------------------------------------
+
+constexpr const char* kSecret = "broker-test-worker-secret";
+
+BrokerOptions curve_options() {
+  BrokerOptions o = test_options();
+  o.curve_secret_key = api::derive_server_keys(kSecret).secret_key;
+  o.auth.allowed_keys = {api::derive_worker_keys(kSecret).public_key};
+  return o;
+}
+
+class BrokerCurveTest : public BrokerTest {
+ protected:
+  std::unique_ptr<RawPeer> curve_peer(const api::CurveKeyPair& keys) {
+    return std::make_unique<RawPeer>(ctx_, broker_->bound_endpoint(), keys, api::derive_server_keys(kSecret).public_key);
+  }
+  // True when `keys` get the welcome heartbeat for their READY.
+  bool joins(const api::CurveKeyPair& keys, const std::string& id, std::chrono::milliseconds wait = 5000ms) {
+    auto p = curve_peer(keys);
+    p->send(RawPeer::ready(id));
+    return p->receive_a<api::HeartbeatMsg>(wait).has_value();
+  }
+};
+
+TEST_F(BrokerCurveTest, AWorkerWithTheDerivedSecretJoinsAndGetsUnits) {
+  start(curve_options());
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  auto p = curve_peer(api::derive_worker_keys(kSecret));
+  p->send(RawPeer::ready("w1"));
+  ASSERT_TRUE(p->receive_a<api::HeartbeatMsg>());
+  auto u = p->receive_a<api::UnitMsg>();
+  ASSERT_TRUE(u);
+  p->send(api::ResultMsg{u->unit, 1, 0.1, "tile"});
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() == 1; }));
+  EXPECT_EQ(broker_->stats().auth_failures, 0u);
+}
+
+TEST_F(BrokerCurveTest, ANullMechanismPeerGetsNothingAndIsCounted) {
+  start(curve_options());
+  backend_.add_unit("j", 0, 0, 0, "{}");
+  auto p = peer();  // no CURVE
+  p->send(RawPeer::ready("intruder"));
+  EXPECT_FALSE(p->receive(500ms).has_value());
+  ASSERT_TRUE(eventually([&] { return broker_->stats().auth_failures >= 1; }));
+  EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty() && f.dispatches.empty(); }));
+}
+
+TEST_F(BrokerCurveTest, AnUnknownKeyIsDenied) {
+  start(curve_options());
+  EXPECT_FALSE(joins(api::generate_curve_keys(), "stranger", 500ms));
+  EXPECT_GE(broker_->stats().auth_failures, 1u);
+  // A key derived from another secret is just as unknown.
+  EXPECT_FALSE(joins(api::derive_worker_keys("some-other-secret-text"), "guess", 500ms));
+  EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty(); }));
+}
+
+TEST_F(BrokerCurveTest, TheAllowListAdmitsItsKeysAndIsRereadWhenItChanges) {
+  const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_broker_keys_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const auto list = dir / "workers.keys";
+  const api::CurveKeyPair first = api::generate_curve_keys(), second = api::generate_curve_keys();
+  std::ofstream(list) << "# workers\n" << first.public_key << " first\n";
+  BrokerOptions o = curve_options();
+  o.auth.allowed_keys.clear();  // the allow-list alone
+  o.auth.keys_path = list.string();
+  o.auth.max_failures = 1000;   // the denied peer's retries must not lock out the loopback address
+  start(o);
+  EXPECT_TRUE(joins(first, "first"));
+  EXPECT_FALSE(joins(second, "second", 500ms));
+  EXPECT_GE(broker_->stats().auth_failures, 1u);
+  std::ofstream(list, std::ios::app) << second.public_key << "\n";
+  EXPECT_TRUE(joins(second, "second"));
+  // A folder of *.pub files works the same way.
+  broker_->stop();
+  const auto folder = dir / "keys.d";
+  std::filesystem::create_directories(folder);
+  o.auth.keys_path = folder.string();
+  start(o);
+  EXPECT_FALSE(joins(first, "first-again", 500ms));
+  std::ofstream(folder / "first.pub") << first.public_key << "\n";
+  EXPECT_TRUE(joins(first, "first-again"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(BrokerCurveTest, RepeatedFailuresLockTheAddressOutEvenForAValidKey) {
+  BrokerOptions o = curve_options();
+  o.auth.max_failures = 3;
+  start(o);
+  ASSERT_TRUE(eventually([&] {
+    EXPECT_FALSE(joins(api::generate_curve_keys(), "stranger", 100ms));
+    return broker_->stats().auth_failures >= 3;
+  }));
+  const auto before = broker_->stats().auth_failures;
+  EXPECT_FALSE(joins(api::derive_worker_keys(kSecret), "w1", 500ms));
+  EXPECT_TRUE(eventually([&] { return broker_->stats().auth_failures > before; }));
+  EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty(); }));
 }
 
 TEST_F(BrokerTest, MalformedFramesAreCountedAndDropped) {

@@ -14,6 +14,7 @@
 #include <zmq.hpp>
 #include <zmq_addon.hpp>
 
+#include "api/curve_keys.h"
 #include "api/render_request.h"
 #include "api/wire.h"
 #include "server/job_service.h"
@@ -189,6 +190,15 @@ class RawPeer {
  public:
   RawPeer(zmq::context_t& ctx, const std::string& endpoint) : socket_(ctx, zmq::socket_type::dealer) {
     socket_.set(zmq::sockopt::linger, 0);
+    socket_.connect(endpoint);
+  }
+  // A CURVE client with key pair `own` of a server whose public key is `server_key` (Z85).
+  RawPeer(zmq::context_t& ctx, const std::string& endpoint, const api::CurveKeyPair& own, const std::string& server_key)
+      : socket_(ctx, zmq::socket_type::dealer) {
+    socket_.set(zmq::sockopt::linger, 0);
+    socket_.set(zmq::sockopt::curve_serverkey, server_key);
+    socket_.set(zmq::sockopt::curve_publickey, own.public_key);
+    socket_.set(zmq::sockopt::curve_secretkey, own.secret_key);
     socket_.connect(endpoint);
   }
   void send_frames(const api::Frames& frames) {

@@ -42,6 +42,20 @@ TEST(ServerOptions, BadValuesNameTheFlag) {
   ::unsetenv("SKYFARM_UNIT_TIMEOUT");
 }
 
+TEST(ServerOptions, WorkerCredentialFlagsAndTheirVariables) {
+  ::setenv("SKYFARM_WORKER_KEYS", "/etc/skyfarm/workers.keys", 1);
+  ::setenv("SKYFARM_WORKER_SECRET_FILE", "/env/worker.secret", 1);
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({"--worker-secret-file", "/flag/worker.secret", "--server-key-file", "/k/server.key"}, &o),
+            "");
+  ::unsetenv("SKYFARM_WORKER_KEYS");
+  ::unsetenv("SKYFARM_WORKER_SECRET_FILE");
+  EXPECT_EQ(o.worker_secret_file, "/flag/worker.secret");
+  EXPECT_EQ(o.worker_keys, "/etc/skyfarm/workers.keys");
+  EXPECT_EQ(o.server_key_file, "/k/server.key");
+  EXPECT_TRUE(o.token.empty());  // the HTTP token is not a worker credential
+}
+
 // The cache sizes and the probe timeout: defaults, flags, environment, and
 // bad values refused naming the flag and the range.
 TEST(ServerOptions, CacheSizesAndProbeTimeout) {

@@ -9,7 +9,11 @@
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <filesystem>
+#include <mutex>
 #include <thread>
 
 #include "api/probe_answer.h"
@@ -279,16 +283,71 @@ TEST_F(FarmWorkerTest, ReconnectsOnANewSocketWhenTheServerGoesSilent) {
   EXPECT_EQ(w.finish(), 0);
 }
 
-TEST_F(FarmWorkerTest, AWrongTokenEndsRunWithOne) {
-  server::BrokerOptions bo = broker_options();
-  bo.token = "s3cret";
-  start_broker(bo);
-  FarmWorkerOptions o = worker_options(broker_->bound_endpoint());
-  o.token = "guess";
+constexpr const char* kSecret = "farm-worker-test-secret";
+
+server::BrokerOptions curve_broker_options() {
+  server::BrokerOptions o = broker_options();
+  o.curve_secret_key = api::derive_server_keys(kSecret).secret_key;
+  o.auth.allowed_keys = {api::derive_worker_keys(kSecret).public_key};
+  return o;
+}
+
+FarmWorkerOptions curve_worker_options(const std::string& endpoint, const api::CurveKeyPair& own) {
+  FarmWorkerOptions o = worker_options(endpoint);
+  o.server_key = api::derive_server_keys(kSecret).public_key;
+  o.public_key = own.public_key;
+  o.secret_key = own.secret_key;
+  return o;
+}
+
+TEST_F(FarmWorkerTest, AWorkerWithTheDerivedSecretRendersOverCurve) {
+  start_broker(curve_broker_options());
+  const std::string request = tiny_request(16);
+  backend_.add_units("a", 1, 2, 1, request);
+  start_worker(curve_worker_options(broker_->bound_endpoint(), api::derive_worker_keys(kSecret)));
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() == 2; }, 10s));
+  backend_.with_lock([&](auto& f) {
+    for (const auto& d : f.done) EXPECT_EQ(d.bytes, local_unit_bytes(request, d.key.tile, d.key.batch, d.key.pass));
+    return 0;
+  });
+  EXPECT_EQ(broker_->stats().auth_failures, 0u);
+}
+
+TEST_F(FarmWorkerTest, AWorkerWithAnUnknownKeyNeverJoinsAndSaysWhy) {
+  start_broker(curve_broker_options());
+  backend_.add_units("a", 1, 2, 1, tiny_request(16));
+  std::vector<std::string> lines;
+  std::mutex mu;
+  FarmWorkerOptions o = curve_worker_options(broker_->bound_endpoint(), api::generate_curve_keys());
+  o.log = [&](std::string_view line) {
+    std::lock_guard lock(mu);
+    lines.emplace_back(line);
+  };
   WorkerThread& w = start_worker(o);
-  ASSERT_TRUE(eventually([&] { return w.rc.load() != -1; }, 3s));
-  EXPECT_EQ(w.rc, 1);
+  ASSERT_TRUE(eventually([&] { return w.worker.stats().auth_failures >= 1; }, 3s));
+  EXPECT_GE(broker_->stats().auth_failures, 1u);
+  EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty() && f.dispatches.empty(); }));
+  EXPECT_EQ(w.finish(), 0);  // before `lines` goes: the worker logs into it
+  std::lock_guard lock(mu);
+  EXPECT_TRUE(std::any_of(lines.begin(), lines.end(),
+                          [](const std::string& l) { return l.find("refused the CURVE handshake") != std::string::npos; }));
+}
+
+TEST_F(FarmWorkerTest, AnIdInUseEndsRunWithOne) {
+  // A 1 s broker interval: the holder (heartbeating every 100 ms) looks dead
+  // only after 2 s of silence, which no loaded machine reaches here.
+  server::BrokerOptions bo = broker_options();
+  bo.heartbeat_interval = 1000ms;
+  start_broker(bo);
+  FarmWorkerOptions first = worker_options(broker_->bound_endpoint());
+  first.id = "twin";
+  start_worker(first);
+  ASSERT_TRUE(joined(1));
+  WorkerThread& second = start_worker(first);
+  ASSERT_TRUE(eventually([&] { return second.rc.load() != -1; }, 3s));
+  EXPECT_EQ(second.rc, 1);
   EXPECT_EQ(broker_->stats().rejected, 1u);
+  EXPECT_EQ(broker_->stats().workers, 1u);
 }
 
 // --- The program -------------------------------------------------------------
@@ -323,9 +382,11 @@ int wait_exit(pid_t pid, std::chrono::milliseconds timeout) {
 }
 
 TEST_F(FarmWorkerTest, ProgramDrainsOnSigtermAndExitsZero) {
-  start_broker();
+  start_broker(curve_broker_options());
   backend_.add_units("a", 2, 2, 1, tiny_request(48));
-  const pid_t pid = spawn_worker({"--threads", "1"}, {"SKYFARM_CONNECT=" + broker_->bound_endpoint(), "SKYFARM_SLOTS=1"});
+  // The secret reaches the program through the environment, as the server hands it to its local workers.
+  const pid_t pid = spawn_worker({"--threads", "1"}, {"SKYFARM_CONNECT=" + broker_->bound_endpoint(), "SKYFARM_SLOTS=1",
+                                                      std::string("SKYFARM_WORKER_SECRET=") + kSecret});
   ASSERT_GT(pid, 0);
   ASSERT_TRUE(joined(1));
   EXPECT_EQ(backend_.with_lock([](FakeBackend& f) { return f.joined[0].second["slots"].get<int>(); }), 1);
@@ -341,6 +402,18 @@ TEST_F(FarmWorkerTest, ProgramRejectsBadFlags) {
   EXPECT_EQ(wait_exit(spawn_worker({"--connect", "nowhere"}, {}), 5s), 2);
   EXPECT_EQ(wait_exit(spawn_worker({"--frobnicate", "1"}, {}), 5s), 2);
   EXPECT_EQ(wait_exit(spawn_worker({}, {"SKYFARM_SLOTS=-2"}), 5s), 2);
+  // No credential for a server beyond loopback; a key file without the server's key; a short secret.
+  EXPECT_EQ(wait_exit(spawn_worker({"--connect", "tcp://192.0.2.1:5555"}, {}), 5s), 2);
+  EXPECT_EQ(wait_exit(spawn_worker({"--connect", "tcp://192.0.2.1:5555"}, {"SKYFARM_WORKER_SECRET=short"}), 5s), 2);
+  const auto key = std::filesystem::temp_directory_path() / ("skyfarm_worker_key_" + std::to_string(::getpid()));
+  std::filesystem::remove(key);
+  std::filesystem::remove(key.string() + ".pub");
+  EXPECT_EQ(wait_exit(spawn_worker({"keygen", key.string()}, {}), 5s), 0);
+  EXPECT_EQ(std::filesystem::status(key).permissions() & std::filesystem::perms::all, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  EXPECT_EQ(wait_exit(spawn_worker({"keygen", key.string()}, {}), 5s), 2);  // never overwrites a key
+  EXPECT_EQ(wait_exit(spawn_worker({"--connect", "tcp://192.0.2.1:5555", "--key-file", key.string()}, {}), 5s), 2);
+  std::filesystem::remove(key);
+  std::filesystem::remove(key.string() + ".pub");
 }
 
 }  // namespace
