@@ -26,6 +26,10 @@ constexpr KnownMetric kKnown[] = {
     {"samples_per_second", "skyfarm_samples_per_second", "gauge", "Samples merged per second, recent average."},
     {"unit_failures", "skyfarm_unit_failures_total", "counter", "Work units reported failed by workers."},
     {"requeues", "skyfarm_unit_requeues_total", "counter", "Work units requeued (lost worker, timeout, failure)."},
+    {"results_refused", "skyfarm_results_refused_total", "counter",
+     "Work unit results refused: not exactly the unit's tile, batch and sample counts, or unreadable."},
+    {"disk_used_bytes", "skyfarm_disk_used_bytes", "gauge", "Bytes the data directory holds (jobs' files, database)."},
+    {"disk_budget_bytes", "skyfarm_disk_budget_bytes", "gauge", "The data directory's disk budget in bytes (0: none)."},
 };
 constexpr std::string_view kJobsPrefix = "jobs_";
 
