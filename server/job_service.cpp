@@ -779,7 +779,7 @@ std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat fo
     job = it->second.get();  // purged jobs are kept (Impl::purged): the pointer outlives the lock
     if (job->expired) return std::nullopt;
     if (job->record.state == "done") return final_file(*job);
-    if (!job->active()) return std::nullopt;  // cancelled or failed: its sums are deleted
+    if (!job->active() && !job->finishing) return std::nullopt;  // cancelled or failed: its sums are deleted
     if (!job->merger->first_pass_complete()) return std::nullopt;
     units = job->merger->merged_units();
     if (job->preview_units == units) return preview_file(*job);
@@ -1243,8 +1243,8 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
   }
   // The final image is encoded and written without the lock: a large one
   // takes seconds, and dispatch, merging and status requests go on meanwhile
-  // (the job, finishing, gets no units).  Jobs are never erased, so `job`
-  // stays valid.
+  // (the job, finishing, gets no units).  A finishing job is not purged
+  // (and purged ones are kept in memory), so `job` stays valid.
   lock.unlock();
   std::optional<std::string> failure;
   try {

@@ -30,13 +30,14 @@ bool all_zero(const PixelBatchSums& s) {
 UnitResultCheck::UnitResultCheck(const RenderPlan& plan, const Camera& camera, std::vector<std::uint32_t> sun_pixels)
     : plan_(plan), camera_(camera), sun_pixels_(std::move(sun_pixels)) {}
 
-// The image circle is convex: when the pixel's four corners have directions,
-// every jittered point inside it has one.
+// The image circle is convex: when the corners of the pixel grown by a pixel
+// on every side have directions, every jittered point of the pixel has one,
+// with a margin no rounding of the circle test can cross.
 bool UnitResultCheck::whole_pixel_has_directions(int x, int y) const {
   if (camera_.projection() != Projection::kFisheye) return true;
   Ray ray;
-  for (double jy : {0.0, 1.0})
-    for (double jx : {0.0, 1.0})
+  for (double jy : {-1.0, 2.0})
+    for (double jx : {-1.0, 2.0})
       if (!camera_.generate_ray(x, y, jx, jy, &ray)) return false;
   return true;
 }
