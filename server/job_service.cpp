@@ -919,21 +919,28 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
   const std::lock_guard<std::mutex> lock(impl_->mu);
   auto& workers = impl_->workers;
   if (auto w = workers.find(worker_id); w != workers.end()) w->second.last_seen = Clock::now();
-  Job* chosen = impl_->fair_choice();
-  if (!chosen) return std::nullopt;
-  Job& job = chosen->group.empty() ? *chosen : impl_->lowest_pass_in_group(*chosen);
+  Job* picked = nullptr;
   std::optional<WorkUnit> unit;
-  while (!job.requeued.empty() && !unit) {
-    const WorkUnit u = job.requeued.front();
-    job.requeued.pop_front();
-    if (!job.merger->received(u)) unit = u;
+  // A job whose units left turn out to be received already has no work after
+  // this look (its queue drained, its cursor at the end or at the allocation
+  // gate), so the next choice is another: the loop ends.
+  while (!unit) {
+    Job* chosen = impl_->fair_choice();
+    if (!chosen) return std::nullopt;
+    picked = chosen->group.empty() ? chosen : &impl_->lowest_pass_in_group(*chosen);
+    Job& job = *picked;
+    while (!job.requeued.empty() && !unit) {
+      const WorkUnit u = job.requeued.front();
+      job.requeued.pop_front();
+      if (!job.merger->received(u)) unit = u;
+    }
+    while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
+      if (job.waits_for_allocation() && unit_at(job.plan, job.cursor).pass > 0) break;
+      const WorkUnit u = unit_at(job.plan, job.cursor++);
+      if (!job.merger->received(u)) unit = u;
+    }
   }
-  while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
-    if (job.waits_for_allocation() && unit_at(job.plan, job.cursor).pass > 0) break;
-    const WorkUnit u = unit_at(job.plan, job.cursor++);
-    if (!job.merger->received(u)) unit = u;
-  }
-  if (!unit) return std::nullopt;
+  Job& job = *picked;
   if (!job.started) {
     job.started = true;
     job.start_time = Clock::now();
