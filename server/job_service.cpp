@@ -705,7 +705,8 @@ PurgeOutcome JobService::purge(const std::string& id) {
   impl_->store->remove(id);
   std::error_code ec;
   fs::remove_all(job.dir, ec);
-  if (!job.record.idempotency_key.empty()) impl_->idempotency.erase(job.record.idempotency_key);
+  // Its own key and those the result cache pointed at it.
+  std::erase_if(impl_->idempotency, [&](const auto& entry) { return entry.second == id; });
   impl_->order.erase(std::find(impl_->order.begin(), impl_->order.end(), id));
   // The object outlives its record: a preview fetch may still hold it (image()).
   job.expired = true;

@@ -972,6 +972,7 @@ TEST(JobService, PurgeRemovesFilesAndRecordAndFreesTheDisk) {
   JobService service(dir);
   const auto request = api::parse_render_request(kRequest);
   const auto id = service.submit(request, std::string("k1")).id;
+  EXPECT_EQ(service.submit(request, std::string("k2")).id, id) << "a second key, by the result cache";
   finish_all(service);
   ASSERT_EQ((*service.status(id))["state"], "done");
   const std::int64_t used = disk_used(service);
@@ -985,6 +986,7 @@ TEST(JobService, PurgeRemovesFilesAndRecordAndFreesTheDisk) {
   const auto again = service.submit(request, std::string("k1"));
   EXPECT_TRUE(again.created);
   EXPECT_NE(again.id, id);
+  EXPECT_EQ(service.submit(request, std::string("k2")).id, again.id) << "k2 no longer names the purged job";
   // An active job: cancelled, then removed; its units are called back.
   const auto a = service.next_unit("w");
   ASSERT_TRUE(a);
