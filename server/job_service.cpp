@@ -563,8 +563,8 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
       const std::int64_t free_mib = std::max<std::int64_t>(0, impl_->disk_budget - committed) / kMiB;
       throw InsufficientStorage(
           "this render needs about " + std::to_string((needs + kMiB - 1) / kMiB) + " MiB of disk (" +
-          std::to_string(plan.tile_count()) + " tiles of " + std::to_string(plan.batches) +
-          " batches, and its images); the disk budget (--max-disk-mb " + std::to_string(impl_->disk_budget / kMiB) +
+          std::to_string(plan.tile_count()) + " tiles x " + std::to_string(plan.batches) +
+          (plan.batches == 1 ? " batch" : " batches") + ", and its images); the disk budget (--max-disk-mb " + std::to_string(impl_->disk_budget / kMiB) +
           ") has " + std::to_string(free_mib) + " MiB free. Render fewer pixels or batches, wait for running "
           "renders to finish, or free space by deleting a finished render (DELETE /v1/renders/{id}?purge=true)");
     }
