@@ -383,8 +383,22 @@ void HttpApi::status(const Request& req, Response& res) {
   send_json_or_throw(res, 200, backend_.status(id), not_found(id));
 }
 
+// DELETE /v1/renders/{id}: cancels (202 with the status; a finished job's
+// status as it is).  ?purge=true also removes the job's files and record:
+// 204, and the id is unknown afterwards.
 void HttpApi::cancel(const Request& req, Response& res) {
   const std::string id = job_id_of(req);
+  const std::size_t given = req.get_param_value_count("purge");
+  const std::string purge = given ? req.get_param_value("purge") : "false";
+  if (given > 1 || (purge != "true" && purge != "false"))
+    throw invalid_parameter("purge", given > 1 ? "must be given once" : "must be true or false", quote_text(purge));
+  if (purge == "true") {
+    const PurgeOutcome outcome = backend_.purge(id);
+    if (outcome.kind == PurgeOutcome::kUnknown) throw not_found(id);
+    if (outcome.kind == PurgeOutcome::kConflict) throw http_error(409, outcome.detail);
+    res.status = 204;
+    return;
+  }
   if (!backend_.cancel(id)) throw not_found(id);
   send_json_or_throw(res, 202, backend_.status(id), not_found(id));
 }
@@ -398,11 +412,17 @@ void HttpApi::image(const Request& req, Response& res, ImageFormat format) {
   if (!file) {
     const std::optional<nlohmann::json> doc = backend_.status(id);
     if (!doc) throw not_found(id);
+    if (doc->value("expired", false))
+      throw http_error(410, "render \"" + id + "\" finished longer ago than this server keeps files "
+                            "(--retention-hours): its images were deleted; submit the request again to render it anew");
+    const std::string state = state_of(doc);
+    if (state == "cancelled" || state == "failed")
+      throw http_error(409, "render \"" + id + "\" is " + state + ": it has no image (its partial results were deleted)");
     Problem p;
     p.status = 409;
     p.type = std::string(kProblemImageNotReady);
     p.title = "The image is not available yet";
-    p.detail = "render \"" + id + "\" (state " + state_of(doc) +
+    p.detail = "render \"" + id + "\" (state " + state +
                ") has no image: its first pass has not covered the whole frame yet";
     throw HttpError(std::move(p));
   }

@@ -29,7 +29,9 @@ constexpr KnownMetric kKnown[] = {
     {"auth_failures", "skyfarm_worker_auth_failures_total", "counter",
      "Worker CURVE handshakes denied or failed (unknown key, wrong mechanism, rate-limited address)."},
     {"results_refused", "skyfarm_results_refused_total", "counter",
-     "Results refused: for an attempt not sent to that worker, or not matching the unit sent."},
+     "Results refused: for an attempt not sent to that worker, or not exactly the unit's tile, batches and sample counts."},
+    {"disk_used_bytes", "skyfarm_disk_used_bytes", "gauge", "Bytes the data directory holds (jobs' files, database)."},
+    {"disk_budget_bytes", "skyfarm_disk_budget_bytes", "gauge", "The data directory's disk budget in bytes (0: none)."},
 };
 constexpr std::string_view kJobsPrefix = "jobs_";
 

@@ -52,6 +52,8 @@ Problem problem_for_current_exception(std::string_view context) {
     Problem p = typed(429, kProblemCapacity, "The farm is at capacity", e.what());
     p.headers.emplace_back("Retry-After", std::to_string(kRetryAfterCapacityS));
     return p;
+  } catch (const InsufficientStorage& e) {
+    return typed(507, kProblemInsufficientStorage, "Not enough disk for this render", e.what());
   } catch (const StorageError& e) {
     log_server_error(context, e.what());
     return typed(507, kProblemStorage, "The server cannot store data",
@@ -105,6 +107,7 @@ std::string_view status_phrase(int status) {
     case 406: return "Not Acceptable";
     case 408: return "Request Timeout";
     case 409: return "Conflict";
+    case 410: return "Gone";
     case 411: return "Length Required";
     case 413: return "Content Too Large";
     case 414: return "URI Too Long";

@@ -28,6 +28,7 @@ inline constexpr std::string_view kProblemIdempotencyConflict = "urn:skyfarm:pro
 inline constexpr std::string_view kProblemCapacity = "urn:skyfarm:problem:capacity-exceeded";
 inline constexpr std::string_view kProblemTooManyStreams = "urn:skyfarm:problem:too-many-streams";
 inline constexpr std::string_view kProblemStorage = "urn:skyfarm:problem:storage-error";
+inline constexpr std::string_view kProblemInsufficientStorage = "urn:skyfarm:problem:insufficient-storage";
 inline constexpr std::string_view kProblemImageNotReady = "urn:skyfarm:problem:image-not-ready";
 inline constexpr std::string_view kProblemNoProbeWorkers = "urn:skyfarm:problem:no-probe-workers";
 inline constexpr std::string_view kProblemProbeTimeout = "urn:skyfarm:problem:probe-timeout";
@@ -68,7 +69,7 @@ void send_problem(httplib::Response& res, const Problem& problem, std::string_vi
 
 // The Problem for an exception thrown while answering a request:
 // ValidationError 400, HttpError its own, IdempotencyConflict 422,
-// CapacityExceeded 429, StorageError 507, anything else 500 with a generic
+// CapacityExceeded 429, InsufficientStorage 507 (the disk budget), StorageError 507, anything else 500 with a generic
 // detail (the message goes to stderr, never to the client).  Never throws.
 Problem problem_from_exception(std::exception_ptr error, std::string_view context) noexcept;
 

@@ -22,8 +22,10 @@
 #include "common/render/sample_allocation.h"
 #include "common/render/sun_pixels.h"
 #include "common/sampling/sampler.h"
+#include "server/disk_budget.h"
 #include "server/job_store.h"
 #include "server/tile_merger.h"
+#include "server/unit_result_check.h"
 
 #include "server/job_ids.h"
 
@@ -124,10 +126,12 @@ struct Job {
   RenderPlan plan;
   nlohmann::json plan_json;
   std::unique_ptr<TileMerger> merger;
+  std::unique_ptr<UnitResultCheck> result_check;  // what a unit's result must be, exactly
   std::size_t cursor = 0;               // next never-dispatched unit index (pass-major)
   std::deque<WorkUnit> requeued;        // units to dispatch again
   std::map<int, std::set<std::string>> failed_workers;  // by pass-major index
   int in_flight = 0;
+  std::uint64_t dispatched = 0;  // units handed out so far (fair share: next_unit)
   std::map<std::string, int> worker_units;
   std::uint64_t paths = 0;
   bool started = false;
@@ -137,6 +141,21 @@ struct Job {
   std::vector<JobEvent> events;
   std::string stopped_by;
   int preview_units = -1;
+  // Disk (disk_budget.h): what the job may write at most (reserved while it
+  // runs), and the bytes of its files other than tiles, measured.
+  std::int64_t disk_estimate = 0;
+  std::int64_t other_bytes = 0;
+  bool expired = false;  // finished longer than the retention ago: its directory is gone
+  // Once its tile files are deleted (it finished, failed or was cancelled):
+  // the merged units and whole passes they held, for the status.
+  std::optional<std::pair<std::int64_t, int>> released;
+  std::int64_t units_done() const { return released ? released->first : merger->merged_units(); }
+  int complete_passes() const { return released ? released->second : merger->complete_passes(); }
+  std::int64_t disk_used() const { return expired ? 0 : merger->bytes_on_disk() + other_bytes; }
+  // What the budget counts: a running job its estimate (it may write that much).
+  std::int64_t disk_reserved() const {
+    return is_terminal(record.state) ? disk_used() : std::max(disk_estimate, disk_used());
+  }
   // Held while a preview is written outside the service's lock; guards preview_written.
   std::mutex preview_writer;
   int preview_written = -1;
@@ -228,9 +247,10 @@ void write_report(Job& job, bool state_change) {
   if (!state_change && job.history.size() > 64 && now - job.report_written < std::chrono::seconds(1)) return;
   job.report_written = now;
   if (!fs::exists(job.dir)) return;
-  const nlohmann::json report = {{"history", job.history},
-                                 {"stopped_by", job.stopped_by},
-                                 {"elapsed_s", job.elapsed_s()}};
+  nlohmann::json report = {{"history", job.history},
+                           {"stopped_by", job.stopped_by},
+                           {"elapsed_s", job.elapsed_s()}};
+  if (job.released) report["released"] = {{"units_done", job.released->first}, {"passes", job.released->second}};
   // Not synced: after a power failure the last second of history may be gone
   // (an unreadable report is ignored), the tiles are still the data.
   write_atomically(job.dir / kReportFile, report.dump(), AtomicFile::Durability::kRenamed);
@@ -256,6 +276,8 @@ void read_report(Job& job) {
     if (r.at("history").is_array()) job.history = r.at("history");
     job.stopped_by = r.at("stopped_by").get<std::string>();
     job.elapsed_before_s = std::max(0.0, r.at("elapsed_s").get<double>());
+    if (r.contains("released"))
+      job.released.emplace(r["released"].at("units_done").get<std::int64_t>(), r["released"].at("passes").get<int>());
   } catch (const std::exception&) {
     // An unreadable report: the status starts again from the tiles.
   }
@@ -319,15 +341,45 @@ struct JobService::Impl {
   std::condition_variable changed;
   std::map<std::string, std::unique_ptr<Job>> jobs;
   std::vector<std::string> order;  // submission order
+  // The jobs that may still get units, in submission order (next_unit prunes
+  // the finished), so that dispatch scans neither finished jobs nor units.
+  std::vector<Job*> runnable;
   std::map<std::string, std::string> idempotency;
   std::map<std::uint64_t, InFlight> in_flight;
   std::uint64_t next_attempt = 1;
   std::vector<std::pair<std::string, std::uint64_t>> cancelled;
   std::map<std::string, WorkerInfo> workers;
   std::int64_t next_sequence = 1;
-  std::uint64_t unit_failures = 0, requeues = 0;
+  std::uint64_t unit_failures = 0, requeues = 0, results_refused = 0;
   std::deque<std::pair<Clock::time_point, std::uint64_t>> recent_paths;  // for samples/s
   std::function<void(const std::string&, const std::string&)> state_observer;
+  // Disk: the budget (0: none), the data directory's bytes outside the jobs'
+  // directories (measured at start: the database, timelapses), purged jobs
+  // kept for threads that still hold them (image()), and the last expiry.
+  std::int64_t disk_budget = 0;
+  std::int64_t base_bytes = 0;
+  std::vector<std::unique_ptr<Job>> purged;
+  Clock::time_point last_expiry{};
+  std::int64_t disk_used() const {
+    std::int64_t total = base_bytes;
+    for (const auto& [id, job] : jobs) total += job->disk_used();
+    return total;
+  }
+  std::int64_t disk_reserved() const {
+    std::int64_t total = base_bytes;
+    for (const auto& [id, job] : jobs) total += job->disk_reserved();
+    return total;
+  }
+  // The bytes of the job's files other than its tiles, measured again.
+  void measure(Job& job) {
+    job.other_bytes = job.expired ? 0 : std::max<std::int64_t>(0, directory_bytes(job.dir) - job.merger->bytes_on_disk());
+  }
+  // A finished, failed or cancelled job's tiles are deleted: only a resume
+  // reads them, and its status keeps their counts (report.json).  Nothing
+  // else reads a finished job's tiles: the final image, its error history
+  // and the timelapses' frames (their final EXRs) are files of their own.
+  void release_tiles(Job& job);
+  std::size_t expire(double now_unix);
 
   Job& add_job(JobRecord record, api::RenderRequest request);
   void set_state(Job& job, const std::string& state, const std::string& failure = "");
@@ -349,11 +401,17 @@ struct JobService::Impl {
   ImageSnapshot snapshot_images(Job& job, bool final);
   void requeue(std::uint64_t attempt, bool tell_worker);
   void fail_job(Job& job, const std::string& message);
+  // A result that is not exactly what its unit asked for: counted, held
+  // against its worker as a failure of the unit (max_unit_failures distinct
+  // workers fail the job), and the unit dispatched again first.
+  void refuse_result(Job& job, const WorkUnit& unit, const std::string& worker_id, const std::string& why);
   // An adaptive job's allocation from its merged pilot, stored before use;
   // false when the job failed instead.
   bool allocate(Job& job);
   void drop_attempts_of(Job& job);
   Job& lowest_pass_in_group(Job& chosen);
+  // The job whose tenant is served next (next_unit), or nullptr when no job has work.
+  Job* fair_choice();
 };
 
 // --- Construction and restart -------------------------------------------------
@@ -374,10 +432,24 @@ JobService::JobService(fs::path data_dir, ServiceLimits limits) : impl_(std::mak
     impl_->next_sequence = std::max(impl_->next_sequence, r.sequence + 1);
     Job& job = impl_->add_job(std::move(r), std::move(request));
     if (job.record.state == "running") impl_->set_state(job, "queued");
-    if (job.record.state == "done" && !fs::exists(job.dir / "image.exr")) impl_->write_images(job, true);
+    if (job.expired) continue;
+    if (job.record.state == "done" && !fs::exists(job.dir / "image.exr") && job.merger->merged_units() > 0)
+      impl_->write_images(job, true);
     if (job.record.state == "done") job.preview_units = job.merger->merged_units();
     impl_->finish_now_if_complete(job);
+    // Finished before tiles were deleted at the end (or stopped by a crash in between).
+    if (is_terminal(job.record.state) && !job.merger->files_removed() &&
+        (job.record.state != "done" || fs::exists(job.dir / "image.exr")))
+      impl_->release_tiles(job);
+    impl_->measure(job);
   }
+  // The budget counts the data directory's other files as they are now.
+  std::int64_t jobs_bytes = 0;
+  for (const auto& [id, job] : impl_->jobs) jobs_bytes += job->disk_used();
+  const std::int64_t all = directory_bytes(impl_->data_dir);
+  impl_->base_bytes = std::max<std::int64_t>(0, all - jobs_bytes);
+  impl_->disk_budget = limits.max_disk_bytes < 0 ? default_disk_budget(impl_->data_dir) : limits.max_disk_bytes;
+  impl_->expire(unix_now());
 }
 
 JobService::~JobService() = default;
@@ -391,18 +463,27 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
     const Camera camera(request.camera,
                         {0.0, 0.0, request.atmosphere.planet_radius_m + request.location.altitude_m});
     job->sun_pixels = sun_pixels(camera, sun);
+    job->result_check = std::make_unique<UnitResultCheck>(job->plan, camera, job->sun_pixels);
   }
   job->dir = data_dir / "jobs" / record.id;
-  job->merger = std::make_unique<TileMerger>(job->plan, job->dir);
+  job->disk_estimate = estimated_job_bytes(request, job->plan);
+  // A finished job without its directory has expired (or lost it): it is not made again.
+  job->expired = record.expired || (is_terminal(record.state) && !fs::exists(job->dir));
+  job->merger = std::make_unique<TileMerger>(job->plan, job->dir, 64u << 20, !job->expired);
   job->passes_reported = job->merger->complete_passes();
   read_report(*job);
   if (job->plan.adaptive) job->allocation = read_allocation(job->dir / kAllocationFile, job->plan);
   if (request.quality.target_relative_error || request.quality.time_limit_s)
     job->merger->set_pass_limit(job->merger->complete_passes() + 1);
+  if (job->expired) job->history = nlohmann::json::array();
   job->record = std::move(record);
   job->request = std::move(request);
+  // Finished before finish times were kept: about when it stopped.
+  if (is_terminal(job->record.state) && job->record.finished_unix <= 0.0)
+    job->record.finished_unix = job->record.created_unix + job->elapsed_before_s;
   if (!job->record.idempotency_key.empty()) idempotency[job->record.idempotency_key] = job->record.id;
   order.push_back(job->record.id);
+  if (!is_terminal(job->record.state)) runnable.push_back(job.get());
   Job& ref = *job;
   jobs[ref.record.id] = std::move(job);
   return ref;
@@ -410,6 +491,10 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
 
 void JobService::Impl::set_state(Job& job, const std::string& state, const std::string& failure) {
   store->set_state(job.record.id, state, failure);
+  if (is_terminal(state) && !is_terminal(job.record.state)) {
+    job.record.finished_unix = unix_now();
+    store->set_finished(job.record.id, job.record.finished_unix);
+  }
   job.record.state = state;
   job.record.failure = failure;
   if (is_terminal(state)) job.end_time = Clock::now();
@@ -446,7 +531,7 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
   // Result cache: an identical request that is done, or still on its way.
   for (const auto& id : impl_->order) {
     const Job& job = *impl_->jobs.at(id);
-    if (job.record.request_hash == hash && (job.record.state == "done" || job.active() || job.finishing)) {
+    if (job.record.request_hash == hash && ((job.record.state == "done" && !job.expired) || job.active() || job.finishing)) {
       if (key) impl_->idempotency[*key] = job.record.id;
       return {job.record.id, false, job.record.state == "done"};
     }
@@ -470,6 +555,20 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
                            "; fewer pixels, batches or samples_per_pixel");
   if (queued_units + units > impl_->limits.max_queue_units)
     throw CapacityExceeded("the queue is full (" + std::to_string(queued_units) + " units waiting); try again later");
+  if (impl_->disk_budget > 0) {
+    const std::int64_t needs = estimated_job_bytes(request, plan);
+    const std::int64_t committed = impl_->disk_reserved();
+    if (committed + needs > impl_->disk_budget) {
+      constexpr std::int64_t kMiB = 1 << 20;
+      const std::int64_t free_mib = std::max<std::int64_t>(0, impl_->disk_budget - committed) / kMiB;
+      throw InsufficientStorage(
+          "this render needs about " + std::to_string((needs + kMiB - 1) / kMiB) + " MiB of disk (" +
+          std::to_string(plan.tile_count()) + " tiles x " + std::to_string(plan.batches) +
+          (plan.batches == 1 ? " batch" : " batches") + ", and its images); the disk budget (--max-disk-mb " + std::to_string(impl_->disk_budget / kMiB) +
+          ") has " + std::to_string(free_mib) + " MiB free. Render fewer pixels or batches, wait for running "
+          "renders to finish, or free space by deleting a finished render (DELETE /v1/renders/{id}?purge=true)");
+    }
+  }
 
   JobRecord r;
   r.id = random_id();
@@ -487,10 +586,10 @@ SubmitResult JobService::submit(const api::RenderRequest& request, const std::op
 }
 
 nlohmann::json JobService::Impl::status_of(const Job& job) const {
-  const std::int64_t merged = job.merger->merged_units(), total = job.merger->total_units();
+  const std::int64_t merged = job.units_done(), total = job.merger->total_units();
   const double fraction = job.progress();
   const double elapsed = job.elapsed_s();
-  const int passes = job.merger->complete_passes();
+  const int passes = job.complete_passes();
   const nlohmann::json spp = job.samples_per_pixel(passes);
   nlohmann::json plan = job.plan_json;
   if (job.allocation)
@@ -530,6 +629,9 @@ nlohmann::json JobService::Impl::status_of(const Job& job) const {
           {"workers", workers_json},
           {"failure", job.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.record.failure)},
           {"created_unix", job.record.created_unix},
+          {"finished_unix", is_terminal(job.record.state) ? nlohmann::json(job.record.finished_unix) : nlohmann::json()},
+          // Finished longer than the retention ago: its files (images) are gone.
+          {"expired", job.expired},
           {"links",
            {{"self", self}, {"exr", self + "/image.exr"}, {"png", self + "/image.png"}, {"events", self + "/events"}}}};
 }
@@ -578,8 +680,47 @@ bool JobService::cancel(const std::string& id) {
   impl_->drop_attempts_of(job);
   job.stopped_by = "cancelled";
   impl_->set_state(job, "cancelled");
+  impl_->release_tiles(job);
   impl_->emit(job, "cancelled");
   return true;
+}
+
+PurgeOutcome JobService::purge(const std::string& id) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  const auto it = impl_->jobs.find(id);
+  if (it == impl_->jobs.end()) return {PurgeOutcome::kUnknown, ""};
+  Job& job = *it->second;
+  if (!job.group.empty())
+    return {PurgeOutcome::kConflict, "render \"" + id + "\" is a frame of timelapse \"" + job.group +
+                                         "\"; delete the timelapse instead"};
+  if (job.finishing)
+    return {PurgeOutcome::kConflict, "render \"" + id + "\" is writing its final image; try again in a moment"};
+  if (job.active()) {
+    impl_->drop_attempts_of(job);
+    job.stopped_by = "cancelled";
+    impl_->set_state(job, "cancelled");
+    impl_->release_tiles(job);
+    impl_->emit(job, "cancelled");
+  }
+  impl_->store->remove(id);
+  std::error_code ec;
+  fs::remove_all(job.dir, ec);
+  // Its own key and those the result cache pointed at it.
+  std::erase_if(impl_->idempotency, [&](const auto& entry) { return entry.second == id; });
+  impl_->order.erase(std::find(impl_->order.begin(), impl_->order.end(), id));
+  // The object outlives its record: a preview fetch may still hold it (image()).
+  job.expired = true;
+  job.events.clear();
+  job.history = nlohmann::json::array();
+  impl_->purged.push_back(std::move(it->second));
+  impl_->jobs.erase(it);
+  impl_->changed.notify_all();
+  return {PurgeOutcome::kPurged, ""};
+}
+
+std::size_t JobService::expire_finished(double now_unix) {
+  const std::lock_guard<std::mutex> lock(impl_->mu);
+  return impl_->expire(now_unix);
 }
 
 // Resolves the merged tiles into an image and writes EXR and PNG next to the
@@ -636,8 +777,10 @@ std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat fo
     const std::lock_guard<std::mutex> lock(impl_->mu);
     const auto it = impl_->jobs.find(id);
     if (it == impl_->jobs.end()) return std::nullopt;
-    job = it->second.get();  // jobs are never erased: the pointer outlives the lock
+    job = it->second.get();  // purged jobs are kept (Impl::purged): the pointer outlives the lock
+    if (job->expired) return std::nullopt;
     if (job->record.state == "done") return final_file(*job);
+    if (!job->active() && !job->finishing) return std::nullopt;  // cancelled or failed: its sums are deleted
     if (!job->merger->first_pass_complete()) return std::nullopt;
     units = job->merger->merged_units();
     if (job->preview_units == units) return preview_file(*job);
@@ -657,12 +800,17 @@ std::optional<ImageFile> JobService::image(const std::string& id, ImageFormat fo
     remove_preview(job->dir, units);
     return final_file(*job);
   }
+  if (!job->active() && !job->finishing) {  // cancelled or failed meanwhile
+    remove_preview(job->dir, units);
+    return std::nullopt;
+  }
   if (units > job->preview_units) {
     if (job->preview_units >= 0) remove_preview(job->dir, job->preview_units);
     job->preview_units = units;
   } else if (units != job->preview_units) {
     remove_preview(job->dir, units);  // overtaken by a newer preview
   }
+  impl_->measure(*job);
   return preview_file(*job);
 }
 
@@ -727,7 +875,10 @@ nlohmann::json JobService::metrics() const {
           {"workers", impl_->workers.size()},
           {"samples_per_second", static_cast<double>(paths) / 10.0},
           {"unit_failures", impl_->unit_failures},
-          {"requeues", impl_->requeues}};
+          {"requeues", impl_->requeues},
+          {"results_refused", impl_->results_refused},
+          {"disk_used_bytes", impl_->disk_used()},
+          {"disk_budget_bytes", impl_->disk_budget}};
 }
 
 // --- Broker side ----------------------------------------------------------
@@ -769,27 +920,28 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
   const std::lock_guard<std::mutex> lock(impl_->mu);
   auto& workers = impl_->workers;
   if (auto w = workers.find(worker_id); w != workers.end()) w->second.last_seen = Clock::now();
-  // Highest priority first, then submission order.
-  Job* best = nullptr;
-  for (const auto& id : impl_->order) {
-    Job& job = *impl_->jobs.at(id);
-    if (!job.has_work()) continue;
-    if (!best || job.record.priority > best->record.priority) best = &job;
-  }
-  if (!best) return std::nullopt;
-  Job& job = best->group.empty() ? *best : impl_->lowest_pass_in_group(*best);
+  Job* picked = nullptr;
   std::optional<WorkUnit> unit;
-  while (!job.requeued.empty() && !unit) {
-    const WorkUnit u = job.requeued.front();
-    job.requeued.pop_front();
-    if (!job.merger->received(u)) unit = u;
+  // A job whose units left turn out to be received already has no work after
+  // this look (its queue drained, its cursor at the end or at the allocation
+  // gate), so the next choice is another: the loop ends.
+  while (!unit) {
+    Job* chosen = impl_->fair_choice();
+    if (!chosen) return std::nullopt;
+    picked = chosen->group.empty() ? chosen : &impl_->lowest_pass_in_group(*chosen);
+    Job& job = *picked;
+    while (!job.requeued.empty() && !unit) {
+      const WorkUnit u = job.requeued.front();
+      job.requeued.pop_front();
+      if (!job.merger->received(u)) unit = u;
+    }
+    while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
+      if (job.waits_for_allocation() && unit_at(job.plan, job.cursor).pass > 0) break;
+      const WorkUnit u = unit_at(job.plan, job.cursor++);
+      if (!job.merger->received(u)) unit = u;
+    }
   }
-  while (!unit && job.cursor < static_cast<std::size_t>(job.plan.unit_count())) {
-    if (job.waits_for_allocation() && unit_at(job.plan, job.cursor).pass > 0) break;
-    const WorkUnit u = unit_at(job.plan, job.cursor++);
-    if (!job.merger->received(u)) unit = u;
-  }
-  if (!unit) return std::nullopt;
+  Job& job = *picked;
   if (!job.started) {
     job.started = true;
     job.start_time = Clock::now();
@@ -801,6 +953,7 @@ std::optional<UnitAssignment> JobService::next_unit(const std::string& worker_id
   const std::uint64_t attempt = impl_->next_attempt++;
   impl_->in_flight[attempt] = InFlight{job.record.id, *unit, worker_id, Clock::now()};
   ++job.in_flight;
+  ++job.dispatched;
   if (auto w = workers.find(worker_id); w != workers.end()) ++w->second.in_flight;
   UnitAssignment a{{job.record.id, unit->tile, unit->batch, unit->pass}, attempt, job.record.request};
   if (unit->pass > 0 && job.allocation)
@@ -819,18 +972,70 @@ static int next_pass(const Job& job) {
 Job& JobService::Impl::lowest_pass_in_group(Job& chosen) {
   Job* pick = &chosen;
   int pick_pass = next_pass(chosen);
-  for (const auto& id : order) {
-    Job& job = *jobs.at(id);
-    if (job.group != chosen.group || job.record.priority != chosen.record.priority || !job.has_work()) continue;
-    const int pass = next_pass(job);
+  for (Job* job : runnable) {
+    if (job->group != chosen.group || job->record.priority != chosen.record.priority || !job->has_work()) continue;
+    const int pass = next_pass(*job);
     if (pass < pick_pass) {
-      pick = &job;
+      pick = job;
       pick_pass = pass;
     }
   }
   return *pick;
 }
 
+// Fair share among the tenants of the highest priority that has work.  A
+// tenant is a job, or a group's jobs of one priority (a timelapse's frames
+// share out as one: lowest_pass_in_group).  The tenant with the fewest units
+// in flight is served, so N tenants each get about 1/N of the workers
+// whatever their sizes, and a small job submitted behind a huge one finishes
+// in about the time it would take alone on its share; ties go to the tenant
+// handed the fewest units so far, then to the earliest submitted.  One scan
+// of the runnable jobs, which also drops the finished ones from it.
+Job* JobService::Impl::fair_choice() {
+  struct Tenant {
+    const std::string* group;  // nullptr: a job alone
+    int priority;
+    int in_flight = 0;
+    std::uint64_t dispatched = 0;
+    Job* first_with_work = nullptr;  // earliest submitted (groups: lowest_pass_in_group picks among them)
+  };
+  auto better = [](const Tenant& a, const Tenant& b) {
+    if (a.priority != b.priority) return a.priority > b.priority;
+    if (a.in_flight != b.in_flight) return a.in_flight < b.in_flight;
+    if (a.dispatched != b.dispatched) return a.dispatched < b.dispatched;
+    return a.first_with_work->record.sequence < b.first_with_work->record.sequence;
+  };
+  std::optional<Tenant> best;
+  std::vector<Tenant> groups;  // few: timelapses in progress
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < runnable.size(); ++i) {
+    Job* job = runnable[i];
+    if (is_terminal(job->record.state)) continue;  // finished: dropped
+    runnable[kept++] = job;
+    const bool work = job->has_work();
+    if (job->group.empty()) {
+      if (!work) continue;
+      Tenant t{nullptr, job->record.priority, job->in_flight, job->dispatched, job};
+      if (!best || better(t, *best)) best = t;
+      continue;
+    }
+    // A group's units in flight count whether or not the frame has work left.
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const Tenant& t) {
+      return *t.group == job->group && t.priority == job->record.priority;
+    });
+    if (g == groups.end()) {
+      groups.push_back(Tenant{&job->group, job->record.priority});
+      g = groups.end() - 1;
+    }
+    g->in_flight += job->in_flight;
+    g->dispatched += job->dispatched;
+    if (work && !g->first_with_work) g->first_with_work = job;
+  }
+  runnable.resize(kept);
+  for (const Tenant& g : groups)
+    if (g.first_with_work && (!best || better(g, *best))) best = g;
+  return best ? best->first_with_work : nullptr;
+}
 
 bool JobService::Impl::allocate(Job& job) {
   const fs::path path = job.dir / kAllocationFile;
@@ -870,6 +1075,7 @@ void JobService::Impl::fail_job(Job& job, const std::string& message) {
   drop_attempts_of(job);
   job.stopped_by = "failed";
   set_state(job, "failed", message);
+  release_tiles(job);
   emit(job, "failed");
 }
 
@@ -936,7 +1142,42 @@ void JobService::Impl::complete_finish(Job& job, const std::string& stopped_by) 
   job.preview_units = job.merger->merged_units();
   job.stopped_by = stopped_by;
   set_state(job, "done");
+  release_tiles(job);
   emit(job, "done");
+}
+
+void JobService::Impl::release_tiles(Job& job) {
+  if (!job.released) job.released.emplace(job.merger->merged_units(), job.merger->complete_passes());
+  job.merger->remove_files();
+  job.pilot_statistics.clear();
+  // A cancelled or failed job shows no partial image: its sums are gone.
+  if (job.record.state != "done" && job.preview_units >= 0) {
+    remove_preview(job.dir, job.preview_units);
+    job.preview_units = -1;
+  }
+  write_report(job, true);
+  measure(job);
+}
+
+std::size_t JobService::Impl::expire(double now_unix) {
+  if (limits.retention_hours <= 0.0) return 0;
+  const double horizon = now_unix - limits.retention_hours * 3600.0;
+  std::size_t n = 0;
+  for (const auto& id : order) {
+    Job& job = *jobs.at(id);
+    if (job.expired || !is_terminal(job.record.state) || job.record.finished_unix > horizon) continue;
+    std::error_code ec;
+    fs::remove_all(job.dir, ec);
+    if (ec) continue;  // tried again at the next check
+    if (!job.merger->files_removed()) release_tiles(job);
+    job.expired = true;
+    job.other_bytes = 0;
+    job.history = nlohmann::json::array();
+    job.preview_units = -1;
+    store->set_expired(job.record.id);
+    ++n;
+  }
+  return n;
 }
 
 void JobService::Impl::finish_now_if_complete(Job& job) {
@@ -958,31 +1199,46 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
   const InFlight f = it->second;
   impl_->in_flight.erase(it);
   auto& workers = impl_->workers;
-  if (auto w = workers.find(worker_id); w != workers.end()) {
+  const auto w = workers.find(worker_id);
+  if (w != workers.end()) {
     --w->second.in_flight;
-    ++w->second.units_done;
     w->second.last_seen = Clock::now();
   }
   Job& job = *impl_->jobs.at(f.job_id);
   --job.in_flight;
   if (!job.active()) return;
+  std::optional<FilmTile> film;
+  std::string refusal;
   try {
-    FilmTile film = FilmTile::deserialize(bytes);
-    if (job.merger->add(f.unit, std::move(film))) {
+    film = FilmTile::deserialize(bytes);
+    // Exactly the unit's tile, batch and sample counts: anything else would
+    // be merged into the image (or, of another size, never merge and hang
+    // the job).
+    WorkUnit asked = f.unit;
+    if (asked.pass > 0 && job.allocation) asked.samples = job.allocation->tile(asked.tile);
+    refusal = job.result_check->check(asked, *film);
+  } catch (const FilmTileDecodeError& e) {
+    refusal = e.what();
+  }
+  if (!refusal.empty()) {
+    impl_->refuse_result(job, f.unit, worker_id, refusal);
+    return;
+  }
+  try {
+    if (job.merger->add(f.unit, std::move(*film))) {
       if (job.waits_for_allocation() && job.merger->merged_units_of(f.unit.tile) == job.plan.batches) {
         job.pilot_statistics.resize(static_cast<std::size_t>(job.plan.tile_count()));
         job.pilot_statistics[static_cast<std::size_t>(f.unit.tile)] = SampleAllocation::pilot_statistics(
             job.plan, f.unit.tile, job.merger->sums_of(f.unit.tile), job.sun_pixels);
       }
+      if (w != workers.end()) ++w->second.units_done;
       ++job.worker_units[worker_id];
       job.paths += paths;
       impl_->recent_paths.emplace_back(Clock::now(), paths);
       while (impl_->recent_paths.size() > 10000) impl_->recent_paths.pop_front();
     }
   } catch (const FilmTileDecodeError& e) {
-    ++impl_->unit_failures;
-    job.failed_workers[static_cast<int>(job.unit_index(f.unit))].insert(worker_id);
-    job.requeued.push_back(f.unit);
+    impl_->refuse_result(job, f.unit, worker_id, e.what());
     return;
   } catch (const StorageError& e) {
     impl_->fail_job(job, e.what());
@@ -995,8 +1251,8 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
   }
   // The final image is encoded and written without the lock: a large one
   // takes seconds, and dispatch, merging and status requests go on meanwhile
-  // (the job, finishing, gets no units).  Jobs are never erased, so `job`
-  // stays valid.
+  // (the job, finishing, gets no units).  A finishing job is not purged
+  // (and purged ones are kept in memory), so `job` stays valid.
   lock.unlock();
   std::optional<std::string> failure;
   try {
@@ -1011,6 +1267,21 @@ void JobService::unit_done(const std::string& worker_id, const UnitKey& key, std
     return;
   }
   impl_->complete_finish(job, pending->stopped_by);
+}
+
+void JobService::Impl::refuse_result(Job& job, const WorkUnit& unit, const std::string& worker_id,
+                                     const std::string& why) {
+  ++results_refused;
+  ++unit_failures;
+  auto& failed = job.failed_workers[static_cast<int>(job.unit_index(unit))];
+  failed.insert(worker_id);
+  if (static_cast<int>(failed.size()) >= limits.max_unit_failures) {
+    fail_job(job, "unit (" + unit_text(unit) + ") got results that do not match it from " +
+                      std::to_string(failed.size()) + " workers; the last (" + worker_id + "): " + why);
+    return;
+  }
+  job.requeued.push_front(unit);
+  ++requeues;
 }
 
 void JobService::unit_failed(const std::string& worker_id, const UnitKey& key, std::uint64_t attempt,
@@ -1043,6 +1314,10 @@ void JobService::check_timeouts(Clock::time_point now) {
   for (const auto& [a, f] : impl_->in_flight)
     if (now - f.since > limit) late.push_back(a);
   for (auto a : late) impl_->requeue(a, true);
+  if (now - impl_->last_expiry >= std::chrono::minutes(1)) {
+    impl_->last_expiry = now;
+    impl_->expire(unix_now());
+  }
 }
 
 // --- Timelapse support ------------------------------------------------------

@@ -6,12 +6,24 @@
 // A job is a validated render request cut by its RenderPlan into units
 // (tile, batch, pass).  Units are handed out pass-major (every tile and batch
 // of pass 0, then pass 1, ...) so the whole frame gets its first samples
-// before any tile gets its second pass, highest job priority first, FIFO
-// within a priority.  A result is merged into its tile only in canonical
+// before any tile gets its second pass.  The highest priority with work wins
+// outright; within it the jobs share the workers fairly (the one with the
+// fewest units in flight is served next, a timelapse's frames counting as
+// one), so a small job is not stuck behind a huge one.  A result is merged
+// only if it is exactly what its unit asked for (unit_result_check.h), and
+// into its tile only in canonical
 // (pass, batch) order; early results wait in memory.  Merged tiles are
 // written atomically to the data directory, so a restarted server resumes
 // from its merged passes and the final image is bit-identical to
 // `skyfarm-worker render`.
+//
+// Disk (ServiceLimits::max_disk_bytes, retention_hours; disk_budget.h): a job
+// is admitted only if its files at their final size fit in the budget beside
+// what the others hold and may still write (InsufficientStorage otherwise,
+// nothing made).  A job's tiles are deleted once it is done (after its final
+// image is written), failed or cancelled; a finished job's directory is
+// removed after the retention (its record stays, "expired"); purge removes a
+// job's files and record at once.
 #pragma once
 #include <chrono>
 #include <cstdint>
@@ -65,6 +77,11 @@ struct CapacityExceeded : std::runtime_error {
 struct StorageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// 507: the job would not fit in the disk budget (ServiceLimits::max_disk_bytes);
+// the message says how much it needs and how much is free.
+struct InsufficientStorage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
 
 // --- Results for the HTTP layer ------------------------------------------
 
@@ -103,6 +120,20 @@ struct ServiceLimits {
   int max_queue_units = 4000000;  // units waiting over all jobs (at most 16 passes of each)
   double unit_timeout_s = 120.0;  // a dispatched unit with no result after this is requeued
   int max_unit_failures = 3;      // distinct workers failing a unit fails its job
+  // The data directory's disk budget in bytes: a job whose files (disk_budget.h)
+  // would not fit beside what the others hold and may still write is refused
+  // (InsufficientStorage).  0: no limit; < 0: default_disk_budget at start.
+  std::int64_t max_disk_bytes = 0;
+  // A job finished (done, failed, cancelled) longer ago than this expires:
+  // its directory is removed, its record stays (status "expired": true, its
+  // images gone).  0: never.
+  double retention_hours = 168.0;
+};
+
+// DELETE /v1/renders/{id}?purge=true.
+struct PurgeOutcome {
+  enum Kind { kPurged, kUnknown, kConflict } kind = kUnknown;
+  std::string detail;  // kConflict: why not (a timelapse's frame, an image being written)
 };
 
 // What the HTTP layer needs (implemented by JobService; tests may fake it).
@@ -118,7 +149,14 @@ class HttpBackend {
   virtual std::size_t job_count() const = 0;
   // false for an unknown id; cancelling a finished job is a no-op returning true.
   virtual bool cancel(const std::string& id) = 0;
-  // nullopt until every unit of the first pass has been merged (or for an unknown id).
+  // Cancels the job if it is active, then removes its files and its record:
+  // afterwards the id is unknown.  Backends without files answer kConflict.
+  virtual PurgeOutcome purge(const std::string& id) {
+    return {PurgeOutcome::kConflict, "render \"" + id + "\" cannot be purged by this server"};
+  }
+  // nullopt until every unit of the first pass has been merged, for an unknown
+  // id, for a cancelled or failed job (its partial results are deleted) and
+  // for an expired one (status "expired": true).
   virtual std::optional<ImageFile> image(const std::string& id, ImageFormat format) = 0;
   // Events with sequence > after; waits up to `timeout` for one; empty on timeout.
   virtual std::vector<JobEvent> events_after(const std::string& id, std::uint64_t after,
@@ -126,7 +164,8 @@ class HttpBackend {
   // GET /v1/workers: [{"id", "cores", "version", "units_done", "units_in_flight", "last_seen_s"}].
   virtual nlohmann::json workers() const = 0;
   // /metrics material: {"queue_units", "units_in_flight", "jobs_queued", "jobs_running", "jobs_done",
-  // "jobs_failed", "workers", "samples_per_second", "unit_failures", "requeues"} (numbers).
+  // "jobs_failed", "workers", "samples_per_second", "unit_failures", "requeues", "results_refused", "disk_used_bytes",
+  // "disk_budget_bytes" (0: no limit)} (numbers).
   virtual nlohmann::json metrics() const = 0;
 };
 
@@ -163,6 +202,7 @@ class JobService final : public HttpBackend, public BrokerBackend {
   nlohmann::json list(std::size_t offset, std::size_t limit) const override;
   std::size_t job_count() const override;
   bool cancel(const std::string& id) override;
+  PurgeOutcome purge(const std::string& id) override;
   std::optional<ImageFile> image(const std::string& id, ImageFormat format) override;
   std::vector<JobEvent> events_after(const std::string& id, std::uint64_t after,
                                      std::chrono::milliseconds timeout) override;
@@ -179,12 +219,17 @@ class JobService final : public HttpBackend, public BrokerBackend {
   std::vector<std::pair<std::string, std::uint64_t>> take_cancelled_attempts() override;
   void check_timeouts(Clock::time_point now) override;
 
+  // Expires the jobs finished more than ServiceLimits::retention_hours
+  // before now_unix (check_timeouts does so once a minute); returns how many.
+  std::size_t expire_finished(double now_unix);
+
   // --- For timelapses (server/timelapse_service.h) ---------------------------
-  // Jobs of one group (a timelapse's frames) share out their passes: when the
-  // job chosen by priority and submission order has a group, the unit handed
-  // out is the one of the lowest next pass among that group's jobs of the
-  // same priority (ties: submission order), so every frame gets pass p before
-  // any gets pass p + 1 and the frames fill in together.  Groups are not
+  // Jobs of one group (a timelapse's frames) share out their passes: they
+  // count as one tenant in the fair share (next_unit), and when that tenant
+  // is served the unit handed out is the one of the lowest next pass among
+  // the group's jobs of the same priority (ties: submission order), so every
+  // frame gets pass p before any gets pass p + 1 and the frames fill in
+  // together.  Groups are not
   // persisted: their owner sets them again after a restart.  false: unknown id.
   bool set_group(const std::string& id, const std::string& group);
   std::optional<JobSummary> summary(const std::string& id) const;

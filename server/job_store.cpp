@@ -60,6 +60,9 @@ JobStore::JobStore(const std::filesystem::path& database) : path_(database) {
       " id TEXT PRIMARY KEY, request TEXT NOT NULL, request_hash TEXT NOT NULL, priority INTEGER NOT NULL,"
       " state TEXT NOT NULL, created REAL NOT NULL, failure TEXT NOT NULL DEFAULT '',"
       " idempotency_key TEXT NOT NULL DEFAULT '', sequence INTEGER NOT NULL)");
+  exec(
+      "CREATE TABLE IF NOT EXISTS job_ends ("
+      " id TEXT PRIMARY KEY, finished REAL NOT NULL, expired INTEGER NOT NULL DEFAULT 0)");
 }
 
 JobStore::~JobStore() { sqlite3_close(db_); }
@@ -98,10 +101,39 @@ void JobStore::set_state(const std::string& id, const std::string& state, const 
   s.step();
 }
 
+void JobStore::set_finished(const std::string& id, double finished_unix) {
+  Statement s(db_, "INSERT OR REPLACE INTO job_ends (id, finished, expired) VALUES (?, ?, 0)", path_);
+  s.bind(1, id);
+  s.bind(2, finished_unix);
+  s.step();
+}
+
+void JobStore::set_expired(const std::string& id) {
+  Statement s(db_, "UPDATE job_ends SET expired = 1 WHERE id = ?", path_);
+  s.bind(1, id);
+  s.step();
+}
+
+void JobStore::remove(const std::string& id) {
+  exec("BEGIN");
+  try {
+    for (const char* sql : {"DELETE FROM jobs WHERE id = ?", "DELETE FROM job_ends WHERE id = ?"}) {
+      Statement s(db_, sql, path_);
+      s.bind(1, id);
+      s.step();
+    }
+    exec("COMMIT");
+  } catch (...) {
+    sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+    throw;
+  }
+}
+
 std::vector<JobRecord> JobStore::load_all() const {
   Statement s(db_,
-              "SELECT id, request, request_hash, priority, state, created, failure, idempotency_key, sequence"
-              " FROM jobs ORDER BY sequence",
+              "SELECT jobs.id, request, request_hash, priority, state, created, failure, idempotency_key, sequence,"
+              " COALESCE(job_ends.finished, 0), COALESCE(job_ends.expired, 0)"
+              " FROM jobs LEFT JOIN job_ends ON job_ends.id = jobs.id ORDER BY sequence",
               path_);
   std::vector<JobRecord> jobs;
   while (s.step()) {
@@ -115,6 +147,8 @@ std::vector<JobRecord> JobStore::load_all() const {
     j.failure = s.text(6);
     j.idempotency_key = s.text(7);
     j.sequence = s.integer(8);
+    j.finished_unix = s.real(9);
+    j.expired = s.integer(10) != 0;
     jobs.push_back(std::move(j));
   }
   return jobs;

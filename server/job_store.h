@@ -1,5 +1,7 @@
 // The persistent record of jobs: an SQLite database in the data directory
-// (jobs and idempotency keys).  Merged film tiles live next to it as files
+// (jobs and idempotency keys; when each finished job finished and whether its
+// files have expired, in a table of their own so that older databases
+// simply gain it).  Merged film tiles live next to it as files
 // (tile_merger.h).  Every write is a transaction; a failure to write (disk
 // full, read-only directory) throws StorageError naming the database.
 #pragma once
@@ -21,7 +23,9 @@ struct JobRecord {
   double created_unix = 0.0;
   std::string failure;      // message when failed
   std::string idempotency_key;
-  std::int64_t sequence = 0;  // submission order (FIFO within a priority)
+  std::int64_t sequence = 0;  // submission order
+  double finished_unix = 0.0;  // when it reached done, failed or cancelled; 0: not yet (or not known)
+  bool expired = false;        // its files were removed after the retention (JobService)
 };
 
 class JobStore {
@@ -33,6 +37,10 @@ class JobStore {
 
   void insert(const JobRecord& job);
   void set_state(const std::string& id, const std::string& state, const std::string& failure = "");
+  void set_finished(const std::string& id, double finished_unix);
+  void set_expired(const std::string& id);
+  // Forgets the job (its idempotency key too).
+  void remove(const std::string& id);
   // All jobs in submission order.
   std::vector<JobRecord> load_all() const;
 

@@ -137,6 +137,8 @@ int main(int argc, char** argv) {
     limits.unit_timeout_s = options.unit_timeout_s;
     limits.max_active_jobs = options.max_active_jobs;
     limits.max_queue_units = options.max_queue_units;
+    limits.max_disk_bytes = options.max_disk_mb < 0 ? -1 : options.max_disk_mb << 20;
+    limits.retention_hours = options.retention_hours;
     JobService service(options.data_dir, limits);
     // Path-traced probes share the workers with renders, ahead of them (probe_router.h).
     ProbeLimits probe_limits;

@@ -27,6 +27,12 @@
 //                               (SKYFARM_ENVMAP_CACHE_MB)
 //   --ffmpeg PATH               ffmpeg for timelapse videos; default: ffmpeg on PATH (SKYFARM_FFMPEG)
 //   --max-timelapse-frames N    frames per timelapse, 400 beyond; default 1000 (SKYFARM_MAX_TIMELAPSE_FRAMES)
+//   --max-disk-mb N             MiB the data directory may hold: a render that would not fit beside
+//                               the others gets 507; default: 80 % of the free space of its filesystem
+//                               plus what it holds, at start; 0 = no limit (SKYFARM_MAX_DISK_MB)
+//   --retention-hours H         finished renders' files are deleted H hours after they finish (the
+//                               record stays, "expired": true); default 168; 0 = never
+//                               (SKYFARM_RETENTION_HOURS)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -54,6 +60,8 @@ struct ServerOptions {
   long long envmap_cache_mb = 128;
   std::string ffmpeg;              // "": ffmpeg on PATH
   int max_timelapse_frames = 1000;
+  long long max_disk_mb = -1;      // -1: sized to the machine at start
+  double retention_hours = 168.0;  // 0: never
   bool help = false;
 };
 

@@ -25,11 +25,13 @@ FilmTile empty_tile(const RenderPlan& plan, int t) {
 
 }  // namespace
 
-TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes)
+TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes,
+                       bool create_dir)
     : plan_(plan), dir_(std::move(dir)), budget_(memory_budget_bytes) {
   std::error_code ec;
-  std::filesystem::create_directories(dir_, ec);
+  if (create_dir) std::filesystem::create_directories(dir_, ec);
   if (ec) throw StorageError("cannot create " + dir_.string() + ": " + ec.message());
+  file_bytes_.assign(static_cast<std::size_t>(plan_.tile_count()), 0);
   cache_.resize(static_cast<std::size_t>(plan_.tile_count()));
   lru_pos_.resize(static_cast<std::size_t>(plan_.tile_count()));
   next_index_.assign(static_cast<std::size_t>(plan_.tile_count()), 0);
@@ -48,7 +50,11 @@ bool TileMerger::received(const WorkUnit& u) const {
 bool TileMerger::add(const WorkUnit& u, FilmTile film) {
   const auto t = static_cast<std::size_t>(u.tile);
   if (received(u)) return false;
-  if (film.x0() != tile_x0(u.tile) || film.y0() != tile_y0(u.tile) || film.batches() != plan_.batches)
+  // The whole geometry: a result of the right origin but another size would
+  // wait here for ever (merge_ready cannot add it), its unit never merged.
+  int x0 = 0, y0 = 0, w = 0, h = 0;
+  plan_.tile_rect(u.tile, &x0, &y0, &w, &h);
+  if (film.x0() != x0 || film.y0() != y0 || film.width() != w || film.height() != h || film.batches() != plan_.batches)
     throw FilmTileDecodeError("result tile does not match tile " + std::to_string(u.tile) + " of the plan");
   waiting_[t].emplace(index_of(u), std::move(film));
   merge_ready(u.tile);
@@ -64,10 +70,6 @@ void TileMerger::merge_ready(int tile_index) {
   FilmTile& target = tile(tile_index);
   for (; it != waiting_[t].end() && next_index_[t] / plan_.batches < pass_limit_;
        it = waiting_[t].find(next_index_[t])) {
-    if (it->second.width() != target.width() || it->second.height() != target.height()) {
-      waiting_[t].erase(it);  // cannot happen for results that passed add()
-      continue;
-    }
     target.merge(it->second);
     waiting_[t].erase(it);
     ++next_index_[t];
@@ -77,6 +79,7 @@ void TileMerger::merge_ready(int tile_index) {
 }
 
 void TileMerger::set_pass_limit(int passes) {
+  if (files_removed_) return;
   const int previous = pass_limit_;
   pass_limit_ = passes;
   if (passes <= previous) return;
@@ -85,6 +88,23 @@ void TileMerger::set_pass_limit(int passes) {
 
 void TileMerger::drop_waiting() {
   for (auto& w : waiting_) w.clear();
+}
+
+void TileMerger::remove_files() {
+  drop_waiting();
+  for (int t = 0; t < plan_.tile_count(); ++t) {
+    const auto i = static_cast<std::size_t>(t);
+    cache_[i].reset();
+    if (file_bytes_[i] == 0) continue;
+    std::error_code ec;
+    std::filesystem::remove(tile_path(t), ec);
+    file_bytes_[i] = 0;
+  }
+  lru_.clear();
+  cached_bytes_ = 0;
+  bytes_on_disk_ = 0;
+  files_removed_ = true;
+  pass_limit_ = 0;  // nothing merges any more
 }
 
 int TileMerger::complete_passes() const {
@@ -123,21 +143,9 @@ std::optional<double> TileMerger::estimated_relative_rms(const std::vector<std::
 
 // File: magic, version, units merged (little-endian uint32 each), then the
 // FilmTile's own serialisation (which carries a CRC).
-int TileMerger::tile_x0(int t) const {
-  int x0 = 0, y0 = 0, w = 0, h = 0;
-  plan_.tile_rect(t, &x0, &y0, &w, &h);
-  return x0;
-}
-
-int TileMerger::tile_y0(int t) const {
-  int x0 = 0, y0 = 0, w = 0, h = 0;
-  plan_.tile_rect(t, &x0, &y0, &w, &h);
-  return y0;
-}
-
 std::filesystem::path TileMerger::tile_path(int t) const { return dir_ / ("tile_" + std::to_string(t) + ".bin"); }
 
-void TileMerger::persist(int t, const FilmTile& film) const {
+void TileMerger::persist(int t, const FilmTile& film) {
   const auto bytes = film.serialize();
   const std::uint32_t header[2] = {kVersion, static_cast<std::uint32_t>(next_index_[static_cast<std::size_t>(t)])};
   try {
@@ -151,6 +159,10 @@ void TileMerger::persist(int t, const FilmTile& film) const {
   } catch (const FileWriteError& e) {
     throw StorageError(e.what());
   }
+  const std::int64_t size = static_cast<std::int64_t>(sizeof kMagic + sizeof header + bytes.size());
+  auto& known = file_bytes_[static_cast<std::size_t>(t)];
+  bytes_on_disk_ += size - known;
+  known = size;
 }
 
 // The tile file, validated against the plan; nullopt when absent or damaged
@@ -182,6 +194,12 @@ std::optional<FilmTile> TileMerger::read_tile(int t, int* units) const {
 // when their tile is next needed).
 void TileMerger::load() {
   for (int t = 0; t < plan_.tile_count(); ++t) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(tile_path(t), ec);
+    if (!ec) {
+      file_bytes_[static_cast<std::size_t>(t)] = static_cast<std::int64_t>(size);
+      bytes_on_disk_ += static_cast<std::int64_t>(size);
+    }
     int units = 0;
     if (!read_tile(t, &units)) continue;
     next_index_[static_cast<std::size_t>(t)] = units;

@@ -32,9 +32,11 @@ namespace skyfarm::server {
 
 class TileMerger {
  public:
-  // Creates `dir` if needed and reloads the tiles found there.  Throws
+  // Creates `dir` if needed (unless create_dir is false: a finished job whose
+  // directory expired) and reloads the tiles found there.  Throws
   // StorageError when the directory cannot be created.
-  TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes = 64u << 20);
+  TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes = 64u << 20,
+             bool create_dir = true);
 
   // A unit's result.  Returns false (and ignores it) when that unit is already
   // merged or waiting.  Throws FilmTileDecodeError on a tile of the wrong
@@ -55,6 +57,13 @@ class TileMerger {
   int pass_limit() const { return pass_limit_; }
   // Forgets results waiting in memory (a job stopped early).
   void drop_waiting();
+  // Deletes the tile files and forgets the sums (a finished, cancelled or
+  // failed job): the counts of merged units stay, nothing merges any more,
+  // and resolve / sums_of / error_sums must not be called after it.
+  void remove_files();
+  bool files_removed() const { return files_removed_; }
+  // The bytes of the tile files on disk.
+  std::int64_t bytes_on_disk() const { return bytes_on_disk_; }
 
   std::int64_t merged_units() const { return merged_units_; }
   std::int64_t total_units() const { return plan_.unit_count(); }
@@ -79,10 +88,8 @@ class TileMerger {
  private:
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }
   void merge_ready(int tile);
-  int tile_x0(int t) const;
-  int tile_y0(int t) const;
   std::filesystem::path tile_path(int tile) const;
-  void persist(int tile, const FilmTile& film) const;
+  void persist(int tile, const FilmTile& film);
   void load();
   // The tile's sums, from memory or disk; keeps the cache within its budget.
   FilmTile& tile(int t) const;
@@ -100,6 +107,9 @@ class TileMerger {
   std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
   std::int64_t merged_units_ = 0;
   int pass_limit_ = 1 << 30;
+  std::vector<std::int64_t> file_bytes_;  // per tile: its file's size (0: none)
+  std::int64_t bytes_on_disk_ = 0;
+  bool files_removed_ = false;
 };
 
 }  // namespace skyfarm::server

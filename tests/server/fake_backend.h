@@ -4,6 +4,7 @@
 // Idempotency works like JobService's: same key + same canonical request ->
 // the same job, another request -> IdempotencyConflict.
 #pragma once
+#include <algorithm>
 #include <chrono>
 #include <condition_variable>
 #include <exception>
@@ -39,6 +40,10 @@ class FakeBackend final : public HttpBackend {
   void set_state(const std::string& id, const std::string& state) {
     std::lock_guard lock(mu_);
     jobs_.at(id)["state"] = state;
+  }
+  void set_field(const std::string& id, const std::string& key, nlohmann::json value) {
+    std::lock_guard lock(mu_);
+    jobs_.at(id)[key] = std::move(value);
   }
   // Appends an event with the next sequence number and wakes waiting streams.
   void push_event(const std::string& id, const std::string& type) {
@@ -148,6 +153,19 @@ class FakeBackend final : public HttpBackend {
     return true;
   }
 
+  // Removes the job; "frame-" ids belong to a timelapse and are refused.
+  PurgeOutcome purge(const std::string& id) override {
+    std::lock_guard lock(mu_);
+    rethrow_if_failing();
+    ids_seen_.push_back(id);
+    const auto it = jobs_.find(id);
+    if (it == jobs_.end()) return {PurgeOutcome::kUnknown, ""};
+    if (id.rfind("frame-", 0) == 0) return {PurgeOutcome::kConflict, "render \"" + id + "\" is a timelapse's frame"};
+    jobs_.erase(it);
+    order_.erase(std::find(order_.begin(), order_.end(), id));
+    return {PurgeOutcome::kPurged, ""};
+  }
+
   std::optional<ImageFile> image(const std::string& id, ImageFormat format) override {
     std::lock_guard lock(mu_);
     rethrow_if_failing();
@@ -215,7 +233,9 @@ class FakeBackend final : public HttpBackend {
   nlohmann::json metrics_ = {{"queue_units", 12},        {"units_in_flight", 3}, {"jobs_queued", 1},
                              {"jobs_running", 2},        {"jobs_done", 5},       {"jobs_failed", 0},
                              {"workers", 2},             {"samples_per_second", 1.5e6},
-                             {"unit_failures", 1},       {"requeues", 4}};
+                             {"unit_failures", 1},       {"requeues", 4},
+                             {"results_refused", 2},     {"disk_used_bytes", 123456789},
+                             {"disk_budget_bytes", 1000000000}};
   int next_id_ = 0;
 };
 

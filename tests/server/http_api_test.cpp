@@ -282,6 +282,12 @@ TEST_F(HttpApiTest, BackendFailuresMapToTheirStatus) {
   expect_problem(full, 507);
   EXPECT_NE(json_of(full)["detail"].get<std::string>().find("disk full"), std::string::npos);
 
+  backend_.fail_next_submit(std::make_exception_ptr(InsufficientStorage("this render needs about 300 MiB")));
+  auto no_room = post(good_request());
+  expect_problem(no_room, 507);
+  EXPECT_EQ(json_of(no_room)["type"], "urn:skyfarm:problem:insufficient-storage");
+  EXPECT_EQ(json_of(no_room)["detail"], "this render needs about 300 MiB");
+
   backend_.fail_next_submit(std::make_exception_ptr(std::runtime_error("secret internals at 0xdead")));
   auto broken = post(good_request());
   expect_problem(broken, 500);
@@ -539,6 +545,43 @@ TEST_F(HttpApiTest, StatusAndCancel) {
   EXPECT_EQ(backend_.cancelled(), std::vector<std::string>{"job-7"});
 }
 
+// ?purge=true removes a render (204, then 404); a timelapse's frame is a
+// 409; anything but true or false is a 400 naming the parameter.
+TEST_F(HttpApiTest, DeleteWithPurgeRemovesTheRender) {
+  start();
+  backend_.add_job("job-8", "done");
+  backend_.add_job("frame-1", "done");
+  auto c = client();
+  auto bad = c.Delete("/v1/renders/job-8?purge=yes");
+  ASSERT_TRUE(bad);
+  expect_problem(bad, 400);
+  EXPECT_NE(bad->body.find("purge"), std::string::npos) << bad->body;
+  auto purged = c.Delete("/v1/renders/job-8?purge=true");
+  ASSERT_TRUE(purged);
+  EXPECT_EQ(purged->status, 204);
+  expect_problem(c.Get("/v1/renders/job-8"), 404);
+  expect_problem(c.Delete("/v1/renders/job-8?purge=true"), 404);
+  expect_problem(c.Delete("/v1/renders/frame-1?purge=true"), 409);
+  auto kept = c.Delete("/v1/renders/frame-1?purge=false");
+  ASSERT_TRUE(kept);
+  EXPECT_EQ(kept->status, 202);
+  EXPECT_TRUE(backend_.cancelled() == std::vector<std::string>{"frame-1"});
+}
+
+// An expired render's images are 410 Gone; a cancelled render's are 409.
+TEST_F(HttpApiTest, ExpiredImagesAreGoneAndCancelledOnesConflict) {
+  start();
+  backend_.add_job("job-old", "done");
+  backend_.set_field("job-old", "expired", true);
+  backend_.add_job("job-stop", "cancelled");
+  auto gone = client().Get("/v1/renders/job-old/image.exr");
+  expect_problem(gone, 410);
+  EXPECT_NE(json_of(gone)["detail"].get<std::string>().find("retention"), std::string::npos);
+  auto stopped = client().Get("/v1/renders/job-stop/image.png");
+  expect_problem(stopped, 409);
+  EXPECT_NE(json_of(stopped)["detail"].get<std::string>().find("cancelled"), std::string::npos);
+}
+
 TEST_F(HttpApiTest, WorkersAndHealth) {
   start();
   auto r = client().Get("/v1/workers");
@@ -789,7 +832,9 @@ TEST_F(HttpApiTest, MetricsAreValidPrometheusText) {
   for (const char* expected : {"skyfarm_queue_units 12\n", "skyfarm_units_in_flight 3\n", "skyfarm_workers 2\n",
                                "skyfarm_samples_per_second 1500000\n", "skyfarm_unit_failures_total 1\n",
                                "skyfarm_jobs{state=\"running\"} 2\n", "skyfarm_http_requests_total{code=\"404\"} 1\n",
-                               "# TYPE skyfarm_unit_failures_total counter\n"})
+                               "# TYPE skyfarm_unit_failures_total counter\n", "skyfarm_results_refused_total 2\n",
+                               "# TYPE skyfarm_results_refused_total counter\n", "skyfarm_disk_used_bytes 123456789\n",
+                               "skyfarm_disk_budget_bytes 1000000000\n"})
     EXPECT_NE(r->body.find(expected), std::string::npos) << expected << " in\n" << r->body;
 }
 

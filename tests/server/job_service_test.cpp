@@ -11,8 +11,11 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
+#include <functional>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <memory>
 #include <random>
@@ -20,6 +23,8 @@
 
 #include "api/render_setup.h"
 #include "common/render/tile_renderer.h"
+#include "server/disk_budget.h"
+#include "server/job_ids.h"
 
 namespace skyfarm::server {
 namespace {
@@ -632,6 +637,399 @@ TEST(JobService, ALongJobsHistoryIsThinnedNotTruncated) {
   for (std::size_t i = 1; i < h.size(); ++i)
     EXPECT_LT(h[i - 1]["samples_per_pixel"].get<int>(), h[i]["samples_per_pixel"].get<int>()) << i;
   EXPECT_EQ((*JobService(dir).status(id))["error"]["history"], h) << "the report holds the same history";
+}
+
+}  // namespace
+}  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// --- Results exactly as asked ------------------------------------------------
+
+FilmTile decoded(const std::vector<std::uint8_t>& bytes) { return FilmTile::deserialize(bytes); }
+
+// `good` copied into a tile of another geometry (the pixels both have).
+std::vector<std::uint8_t> regeometried(const FilmTile& good, int width, int height, int batches) {
+  FilmTile bad(good.x0(), good.y0(), width, height, batches);
+  for (int b = 0; b < std::min(batches, good.batches()); ++b)
+    for (int y = good.y0(); y < good.y0() + std::min(height, good.height()); ++y)
+      for (int x = good.x0(); x < good.x0() + std::min(width, good.width()); ++x)
+        bad.set_sums(x, y, b, good.sums(x, y, b));
+  return bad.serialize();
+}
+
+// The first pixel of the unit's batch with samples, changed by `change`.
+std::vector<std::uint8_t> with_pixel(FilmTile film, int batch, void (*change)(PixelBatchSums*)) {
+  for (int y = film.y0(); y < film.y0() + film.height(); ++y)
+    for (int x = film.x0(); x < film.x0() + film.width(); ++x)
+      if (film.sums(x, y, batch).n > 0) {
+        PixelBatchSums s = film.sums(x, y, batch);
+        change(&s);
+        film.set_sums(x, y, batch, s);
+        return film.serialize();
+      }
+  ADD_FAILURE() << "no pixel with samples";
+  return film.serialize();
+}
+
+std::uint64_t refused(const JobService& service) { return service.metrics()["results_refused"].get<std::uint64_t>(); }
+
+// Each kind of wrong result is refused, counted and its unit handed out again
+// at once (never left waiting); the job then finishes with the local render's bytes.
+TEST(JobService, ResultsNotExactlyAsAskedAreRefusedCountedAndRequeued) {
+  const fs::path dir = fresh_dir("refuse");
+  JobService service(dir);
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  using Bad = std::function<std::vector<std::uint8_t>(const FilmTile&, int batch)>;
+  const std::vector<std::pair<std::string, Bad>> cases = {
+      {"wrong width", [](const FilmTile& g, int) { return regeometried(g, g.width() - 1, g.height(), g.batches()); }},
+      {"wrong height", [](const FilmTile& g, int) { return regeometried(g, g.width(), g.height() + 1, g.batches()); }},
+      {"wrong batches", [](const FilmTile& g, int) { return regeometried(g, g.width(), g.height(), g.batches() + 1); }},
+      {"one sample too many",
+       [](const FilmTile& g, int b) { return with_pixel(g, b, [](PixelBatchSums* s) { s->n += 1.0; }); }},
+      {"one sample too few",
+       [](const FilmTile& g, int b) { return with_pixel(g, b, [](PixelBatchSums* s) { s->n -= 1.0; }); }},
+      {"samples in another batch",
+       [](const FilmTile& g, int b) {
+         FilmTile f = g;
+         f.set_sums(g.x0(), g.y0(), 1 - b, g.sums(g.x0(), g.y0(), b));
+         return f.serialize();
+       }},
+      {"NaN sum",
+       [](const FilmTile& g, int b) {
+         return with_pixel(g, b, [](PixelBatchSums* s) { s->sum_y = std::numeric_limits<double>::quiet_NaN(); });
+       }},
+      {"negative sum of squares",
+       [](const FilmTile& g, int b) { return with_pixel(g, b, [](PixelBatchSums* s) { s->sum_r2 = -1.0; }); }},
+      {"unreadable", [](const FilmTile&, int) { return std::vector<std::uint8_t>{1, 2, 3}; }},
+  };
+  std::uint64_t expected_refused = 0;
+  for (const auto& [name, make_bad] : cases) {
+    SCOPED_TRACE(name);
+    const auto a = service.next_unit("liar");
+    ASSERT_TRUE(a);
+    const std::uint64_t requeues = service.metrics()["requeues"].get<std::uint64_t>();
+    const auto good = render_assignment(*a);
+    service.unit_done("liar", a->key, a->attempt, make_bad(decoded(good), a->key.batch), 1);
+    EXPECT_EQ(refused(service), ++expected_refused);
+    EXPECT_EQ(service.metrics()["requeues"].get<std::uint64_t>(), requeues + 1);
+    EXPECT_EQ((*service.status(id))["state"], "running");
+    // The same unit comes straight back, to be rendered by an honest worker.
+    const auto again = service.next_unit("honest");
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->key, a->key);
+    EXPECT_NE(again->attempt, a->attempt);
+    service.unit_done("honest", again->key, again->attempt, good, 1);
+  }
+  // The liar failed a unit each time, but never the same one three times.
+  std::mt19937 rng(3);
+  run_shuffled(service, rng, 5);
+  ASSERT_EQ((*service.status(id))["state"], "done");
+  EXPECT_EQ(refused(service), expected_refused) << "honest results are all accepted";
+  EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local"));
+}
+
+// A unit refused from three distinct workers fails its job, saying why,
+// instead of going round for ever.
+TEST(JobService, AUnitRefusedFromThreeWorkersFailsItsJob) {
+  JobService service(fresh_dir("refuse3"));
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  std::optional<UnitKey> first;
+  for (int w = 0; w < 3; ++w) {
+    const auto a = service.next_unit(worker_name(w));
+    ASSERT_TRUE(a);
+    if (!first) first = a->key;
+    EXPECT_EQ(a->key, *first) << "the refused unit comes back first";
+    const FilmTile g = decoded(render_assignment(*a));
+    service.unit_done(worker_name(w), a->key, a->attempt, regeometried(g, g.width() - 1, g.height(), g.batches()), 1);
+  }
+  const auto s = *service.status(id);
+  EXPECT_EQ(s["state"], "failed");
+  EXPECT_NE(s["failure"].get<std::string>().find("do not match"), std::string::npos) << s["failure"];
+  EXPECT_EQ(refused(service), 3u);
+}
+
+// The expected counts follow the renderer where it leaves samples out or
+// adds fewer: a fisheye's pixels the image circle crosses (jitter outside
+// it), pixels outside the circle, and the pooled ground rows of an observer
+// at 0 m; honest results of such jobs are all accepted.
+TEST(JobService, HonestResultsOfFisheyeAndPooledGroundJobsAreAllAccepted) {
+  constexpr const char* kFisheye = R"({
+    "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "fisheye", "width": 40, "height": 40, "pitch_deg": 90, "fov_deg": 180},
+    "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 32},
+    "output": {"half": false},
+    "seed": 5
+  })";
+  const fs::path dir = fresh_dir("honest");
+  JobService service(dir);
+  const auto fisheye = service.submit(api::parse_render_request(kFisheye), std::nullopt).id;
+  const auto ground = service.submit(api::parse_render_request(R"({
+    "sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "equirectangular", "width": 48, "height": 24},
+    "quality": {"samples_per_pixel": 32}, "seed": 6})"), std::nullopt).id;
+  EXPECT_TRUE((*service.status(ground))["plan"]["pooled_ground_row"].is_number());
+  std::mt19937 rng(5);
+  run_shuffled(service, rng, 6);
+  EXPECT_EQ((*service.status(fisheye))["state"], "done");
+  EXPECT_EQ((*service.status(ground))["state"], "done");
+  EXPECT_EQ(refused(service), 0u);
+  EXPECT_EQ(read_file(service.image(fisheye, ImageFormat::kExr)->path), local_render_exr(dir / "local", kFisheye));
+}
+
+}  // namespace
+}  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// --- Fair scheduling -------------------------------------------------------------
+
+// A huge job (256 passes of 2 batches) submitted first and a small one
+// (2 passes of 2 batches) after it, equal priority, three workers each
+// taking one unit at a time from a broker loop: the small job finishes while
+// the huge one has done only a sliver of its work.
+TEST(JobService, ASmallJobBehindAHugeOneOfEqualPriorityFinishesFirst) {
+  JobService service(fresh_dir("fair"));
+  const auto huge = service.submit(api::parse_render_request(R"({"sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "equirectangular", "width": 16, "height": 8},
+    "spectral": {"batches": 2}, "quality": {"samples_per_pixel": 4096}, "seed": 1})"), std::nullopt).id;
+  const auto small = service.submit(api::parse_render_request(R"({"sun": {"zenith_deg": 50, "azimuth_deg": 140},
+    "camera": {"projection": "equirectangular", "width": 16, "height": 8},
+    "spectral": {"batches": 2}, "quality": {"samples_per_pixel": 32}, "seed": 2})"), std::nullopt).id;
+  const std::vector<std::string> workers = {"w0", "w1", "w2"};
+  for (const auto& w : workers) service.worker_joined(w, {{"cores", 1}, {"slots", 1}});
+  std::deque<std::pair<std::string, UnitAssignment>> held;  // oldest first
+  int steps = 0;
+  while ((*service.status(small))["state"] != "done" && steps < 100) {
+    ++steps;
+    for (const auto& w : workers) {
+      const bool busy = std::any_of(held.begin(), held.end(), [&](const auto& h) { return h.first == w; });
+      if (busy) continue;
+      if (auto a = service.next_unit(w)) held.emplace_back(w, *a);
+    }
+    ASSERT_FALSE(held.empty());
+    const auto [w, a] = held.front();
+    held.pop_front();
+    service.unit_done(w, a.key, a.attempt, render_assignment(a), 1);
+  }
+  EXPECT_EQ((*service.status(small))["state"], "done");
+  const auto h = *service.status(huge);
+  EXPECT_EQ(h["state"], "running");
+  EXPECT_LE(h["progress"]["units_done"].get<int>(), 8) << "of " << h["progress"]["units_total"];
+  EXPECT_LE(steps, 12);
+}
+
+// Priorities still win outright: while the urgent job has work, no unit of
+// the earlier, less urgent job is handed out.
+TEST(JobService, AHigherPriorityTakesEveryUnitWhileItHasWork) {
+  JobService service(fresh_dir("priority_all"));
+  auto low = api::parse_render_request(kRequest);
+  low.priority = 10;
+  auto high = low;
+  high.priority = 90;
+  high.seed = 77;
+  const auto low_id = service.submit(low, std::nullopt).id;
+  const auto high_id = service.submit(high, std::nullopt).id;
+  const int high_units = (*service.status(high_id))["plan"]["units"].get<int>();
+  for (int i = 0; i < high_units; ++i) {
+    const auto a = service.next_unit("w");
+    ASSERT_TRUE(a);
+    EXPECT_EQ(a->key.job_id, high_id) << i;
+  }
+  const auto next = service.next_unit("w");
+  ASSERT_TRUE(next);
+  EXPECT_EQ(next->key.job_id, low_id);
+}
+
+}  // namespace
+}  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// --- Disk budget, reclaiming and retention ----------------------------------------
+
+int tile_files(const fs::path& dir) {
+  int n = 0;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.path().filename().string().rfind("tile_", 0) == 0) ++n;
+  return n;
+}
+
+std::int64_t disk_used(const JobService& s) { return s.metrics()["disk_used_bytes"].get<std::int64_t>(); }
+
+void finish_all(JobService& service) {
+  while (const auto a = service.next_unit("w")) service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+}
+
+// A job whose files would not fit in the budget is refused before anything
+// is made, saying what it needs and what is free; a small one still fits.
+TEST(JobService, AdmissionRefusesAJobOverTheDiskBudgetAndCreatesNothing) {
+  const fs::path dir = fresh_dir("disk_admission");
+  ServiceLimits limits;
+  limits.max_disk_bytes = 4 << 20;
+  JobService service(dir, limits);
+  EXPECT_EQ(service.metrics()["disk_budget_bytes"].get<std::int64_t>(), 4 << 20);
+  const auto big = api::parse_render_request(R"({"sun": {"zenith_deg": 30, "azimuth_deg": 10},
+    "camera": {"projection": "equirectangular", "width": 512, "height": 256}, "spectral": {"batches": 2}})");
+  try {
+    service.submit(big, std::string("key-big"));
+    FAIL() << "512 x 256 x 2 batches of tiles is ~19 MB, over 4 MiB";
+  } catch (const InsufficientStorage& e) {
+    const std::string m = e.what();
+    const auto at = m.find("needs about ");
+    ASSERT_NE(at, std::string::npos) << m;
+    EXPECT_GE(std::stoi(m.substr(at + 12)), 18) << "at least its tiles: " << m;
+    EXPECT_NE(m.find("MiB free"), std::string::npos) << m;
+    EXPECT_NE(m.find("purge=true"), std::string::npos) << m;
+  }
+  EXPECT_EQ(service.job_count(), 0u);
+  EXPECT_TRUE(fs::is_empty(dir / "jobs")) << "nothing is created on refusal";
+  const auto small = service.submit(api::parse_render_request(kRequest), std::string("key-big"));
+  EXPECT_TRUE(small.created) << "the refused request's key was not taken";
+}
+
+// The estimate is what a job really writes at most: each tile file has
+// exactly its estimated size, and the finished directory fits the estimate.
+TEST(JobService, TheDiskEstimateBoundsWhatAJobWrites) {
+  const fs::path dir = fresh_dir("disk_estimate");
+  JobService service(dir);
+  const auto request = api::parse_render_request(kRequest);
+  const auto id = service.submit(request, std::nullopt).id;
+  const RenderPlan plan = api::render_plan_for(request, Sun::from_spec(request.sun, request.location, request.time));
+  const int first_pass = plan.tile_count() * plan.batches;
+  for (int i = 0; i < first_pass; ++i) {
+    const auto a = service.next_unit("w");
+    service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+  }
+  for (int t = 0; t < plan.tile_count(); ++t)
+    EXPECT_EQ(static_cast<std::int64_t>(fs::file_size(dir / "jobs" / id / ("tile_" + std::to_string(t) + ".bin"))),
+              tile_file_bytes(plan, t));
+  ASSERT_TRUE(service.image(id, ImageFormat::kExr));  // a preview
+  const std::int64_t peak = directory_bytes(dir / "jobs" / id);
+  EXPECT_GE(disk_used(service), peak) << "used counts the job's files";
+  EXPECT_LE(disk_used(service), directory_bytes(dir)) << "and what else the data directory held at start";
+  finish_all(service);
+  EXPECT_LE(peak, estimated_job_bytes(request, plan));
+  EXPECT_LE(directory_bytes(dir / "jobs" / id), estimated_job_bytes(request, plan));
+}
+
+// A cancelled job's tiles (and preview) go at once; its status stays.  A
+// done job's tiles go once its image is written: its status keeps the
+// counts, also after a restart, and its image is still served.
+TEST(JobService, CancelledAndDoneJobsKeepNoTiles) {
+  const fs::path dir = fresh_dir("disk_reclaim");
+  std::string cancelled, done;
+  std::int64_t used_before_restart = 0;
+  nlohmann::json done_status;
+  {
+    JobService service(dir);
+    cancelled = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+    for (int i = 0; i < 6; ++i) {
+      const auto a = service.next_unit("w");
+      service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);
+    }
+    EXPECT_GT(tile_files(dir / "jobs" / cancelled), 0);
+    const std::int64_t with_tiles = disk_used(service);
+    ASSERT_TRUE(service.cancel(cancelled));
+    EXPECT_EQ(tile_files(dir / "jobs" / cancelled), 0);
+    EXPECT_LT(disk_used(service), with_tiles);
+    const auto s = *service.status(cancelled);
+    EXPECT_EQ(s["state"], "cancelled");
+    EXPECT_EQ(s["expired"], false);
+    EXPECT_FALSE(service.image(cancelled, ImageFormat::kPng).has_value());
+
+    auto other = api::parse_render_request(kRequest);
+    other.seed = 11;
+    done = service.submit(other, std::nullopt).id;
+    finish_all(service);
+    done_status = *service.status(done);
+    ASSERT_EQ(done_status["state"], "done");
+    EXPECT_EQ(tile_files(dir / "jobs" / done), 0);
+    EXPECT_TRUE(fs::exists(service.image(done, ImageFormat::kExr)->path));
+    used_before_restart = disk_used(service);
+    EXPECT_GE(used_before_restart, directory_bytes(dir / "jobs"));
+  }
+  JobService restarted(dir);
+  const auto s = *restarted.status(done);
+  EXPECT_EQ(s["progress"], done_status["progress"]);
+  EXPECT_EQ(s["error"]["history"], done_status["error"]["history"]);
+  EXPECT_TRUE(fs::exists(restarted.image(done, ImageFormat::kExr)->path));
+  // The restarted service counts what is on disk.
+  EXPECT_EQ(disk_used(restarted), directory_bytes(dir));
+  EXPECT_GE(disk_used(restarted), directory_bytes(dir / "jobs"));
+  EXPECT_GT(directory_bytes(dir / "jobs"), 0);
+}
+
+// Purge removes a finished job's files and record; an active one is
+// cancelled first.  The disk it held is free again.
+TEST(JobService, PurgeRemovesFilesAndRecordAndFreesTheDisk) {
+  const fs::path dir = fresh_dir("disk_purge");
+  JobService service(dir);
+  const auto request = api::parse_render_request(kRequest);
+  const auto id = service.submit(request, std::string("k1")).id;
+  EXPECT_EQ(service.submit(request, std::string("k2")).id, id) << "a second key, by the result cache";
+  finish_all(service);
+  ASSERT_EQ((*service.status(id))["state"], "done");
+  const std::int64_t used = disk_used(service);
+  EXPECT_EQ(service.purge(id).kind, PurgeOutcome::kPurged);
+  EXPECT_FALSE(service.status(id).has_value());
+  EXPECT_FALSE(fs::exists(dir / "jobs" / id));
+  EXPECT_LT(disk_used(service), used);
+  EXPECT_EQ(service.purge(id).kind, PurgeOutcome::kUnknown);
+  EXPECT_EQ(service.job_count(), 0u);
+  // Neither its key nor the result cache points at it any more.
+  const auto again = service.submit(request, std::string("k1"));
+  EXPECT_TRUE(again.created);
+  EXPECT_NE(again.id, id);
+  EXPECT_EQ(service.submit(request, std::string("k2")).id, again.id) << "k2 no longer names the purged job";
+  // An active job: cancelled, then removed; its units are called back.
+  const auto a = service.next_unit("w");
+  ASSERT_TRUE(a);
+  EXPECT_EQ(service.purge(again.id).kind, PurgeOutcome::kPurged);
+  EXPECT_EQ(service.take_cancelled_attempts().size(), 1u);
+  service.unit_done("w", a->key, a->attempt, render_assignment(*a), 1);  // late: dropped
+  EXPECT_FALSE(service.next_unit("w").has_value());
+  // A timelapse's frame is not purged alone.
+  const auto frame = service.submit(request, std::nullopt).id;
+  ASSERT_TRUE(service.set_group(frame, "timelapse-x"));
+  EXPECT_EQ(service.purge(frame).kind, PurgeOutcome::kConflict);
+  // And the records are gone after a restart too.
+  JobService restarted(dir);
+  EXPECT_FALSE(restarted.status(id).has_value());
+  EXPECT_FALSE(restarted.status(again.id).has_value());
+  EXPECT_TRUE(restarted.status(frame).has_value());
+}
+
+// Jobs finished longer than the retention ago lose their directory; the
+// record stays, marked expired, without images, also after a restart.
+TEST(JobService, FinishedJobsExpireAfterTheRetention) {
+  const fs::path dir = fresh_dir("disk_expire");
+  ServiceLimits limits;
+  limits.retention_hours = 2.0;
+  std::string id;
+  {
+    JobService service(dir, limits);
+    id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+    finish_all(service);
+    ASSERT_EQ((*service.status(id))["state"], "done");
+    EXPECT_EQ(service.expire_finished(unix_now() + 3600.0), 0u) << "an hour later: kept";
+    EXPECT_EQ(service.expire_finished(unix_now() + 3.0 * 3600.0), 1u);
+    EXPECT_FALSE(fs::exists(dir / "jobs" / id));
+    const auto s = *service.status(id);
+    EXPECT_EQ(s["state"], "done");
+    EXPECT_EQ(s["expired"], true);
+    EXPECT_FALSE(service.image(id, ImageFormat::kExr).has_value());
+    // The result cache does not hand out an expired job.
+    EXPECT_TRUE(service.submit(api::parse_render_request(kRequest), std::nullopt).created);
+  }
+  JobService restarted(dir, limits);
+  EXPECT_EQ((*restarted.status(id))["expired"], true);
+  EXPECT_FALSE(fs::exists(dir / "jobs" / id)) << "an expired job's directory is not made again";
 }
 
 }  // namespace

@@ -98,3 +98,31 @@ TEST(ServerOptions, CacheSizesAndProbeTimeout) {
 
 }  // namespace
 }  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// The disk budget and the retention: defaults (sized at start; a week),
+// flags, environment, and bad values refused naming the flag and the range.
+TEST(ServerOptions, DiskBudgetAndRetention) {
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({}, &o), "");
+  EXPECT_EQ(o.max_disk_mb, -1) << "sized to the machine at start";
+  EXPECT_EQ(o.retention_hours, 168.0);
+  ::setenv("SKYFARM_MAX_DISK_MB", "2048", 1);
+  ::setenv("SKYFARM_RETENTION_HOURS", "24", 1);
+  ASSERT_EQ(parse_server_options({"--retention-hours", "0.5"}, &o), "");
+  ::unsetenv("SKYFARM_MAX_DISK_MB");
+  ::unsetenv("SKYFARM_RETENTION_HOURS");
+  EXPECT_EQ(o.max_disk_mb, 2048);
+  EXPECT_EQ(o.retention_hours, 0.5);
+  ASSERT_EQ(parse_server_options({"--max-disk-mb", "0", "--retention-hours", "0"}, &o), "");
+  EXPECT_EQ(o.max_disk_mb, 0) << "no limit";
+  EXPECT_EQ(parse_server_options({"--max-disk-mb", "-5"}, &o),
+            "--max-disk-mb: invalid value '-5' (a whole number of MiB in [0, 1073741824]; 0 = no limit)");
+  EXPECT_EQ(parse_server_options({"--retention-hours", "forever"}, &o),
+            "--retention-hours: invalid value 'forever' (hours in [0, 1000000]; 0 = never)");
+}
+
+}  // namespace
+}  // namespace skyfarm::server

@@ -76,3 +76,44 @@ TEST(TileMerger, PassLimitMergesExactlyThatManyPasses) {
 
 }  // namespace
 }  // namespace skyfarm::server
+
+namespace skyfarm::server {
+namespace {
+
+// A result of the right origin but another size is refused at once (it
+// could never merge: the unit would wait for ever); the tile files are
+// counted on disk and removed whole by remove_files, the counts kept.
+TEST(TileMerger, AResultOfAnotherSizeIsRefusedAndFilesAreCountedAndRemoved) {
+  const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 35, "azimuth_deg": 10},
+    "camera": {"projection": "equirectangular", "width": 48, "height": 16}, "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 16}})");
+  const api::RenderSetup setup = api::make_render_setup(request);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_merger_size_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  TileMerger merger(setup.plan, dir);
+  const WorkUnit u{0, 0, 0};
+  EXPECT_THROW(merger.add(u, FilmTile(0, 0, 31, 16, 2)), FilmTileDecodeError);
+  EXPECT_THROW(merger.add(u, FilmTile(0, 0, 32, 15, 2)), FilmTileDecodeError);
+  EXPECT_THROW(merger.add(u, FilmTile(0, 0, 32, 16, 3)), FilmTileDecodeError);
+  EXPECT_FALSE(merger.received(u)) << "nothing waits";
+  EXPECT_EQ(merger.bytes_on_disk(), 0);
+  PathCounters counters;
+  for (const auto& unit : setup.plan.units()) {
+    FilmTile film = renderer.empty_tile(unit.tile);
+    renderer.render_unit(unit, &film, &counters);
+    ASSERT_TRUE(merger.add(unit, std::move(film)));
+  }
+  ASSERT_TRUE(merger.complete());
+  std::int64_t files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += static_cast<std::int64_t>(e.file_size());
+  EXPECT_EQ(merger.bytes_on_disk(), files);
+  EXPECT_EQ(TileMerger(setup.plan, dir).bytes_on_disk(), files) << "counted again when reloaded";
+  merger.remove_files();
+  EXPECT_TRUE(std::filesystem::is_empty(dir));
+  EXPECT_EQ(merger.bytes_on_disk(), 0);
+  EXPECT_TRUE(merger.complete()) << "the counts stay";
+}
+
+}  // namespace
+}  // namespace skyfarm::server

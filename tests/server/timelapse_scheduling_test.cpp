@@ -1,7 +1,7 @@
-// Group scheduling in the JobService (issue 7): the frames of one timelapse
+// Group scheduling in the JobService: the frames of one timelapse
 // share out their passes, so pass p of every frame is handed out before pass
 // p + 1 of any, and frame 1 starts long before frame 0 has all its passes;
-// jobs without a group keep the old order (one job after another).
+// a group is one tenant of the fair share between jobs of one priority.
 #include "server/job_service.h"
 
 #include <gtest/gtest.h>
@@ -72,11 +72,36 @@ TEST(TimelapseScheduling, GroupedFramesGetPassPOfEveryFrameBeforePassPPlus1OfAny
   for (int k = 0; k < 6; ++k) EXPECT_EQ(handed[static_cast<std::size_t>(k)].frame, k / 2);
 }
 
-TEST(TimelapseScheduling, WithoutAGroupJobsRunOneAfterAnother) {
+TEST(TimelapseScheduling, WithoutAGroupJobsShareTheWorkersInTurn) {
   JobService service(fresh_dir("plain"));
   const auto handed = hand_out_all(service, 3, "");
   ASSERT_EQ(handed.size(), 18u);
-  for (std::size_t i = 0; i < handed.size(); ++i) EXPECT_EQ(handed[i].frame, static_cast<int>(i / 6)) << i;
+  // Equal priority, nothing returned: the job with the fewest units in
+  // flight is served, so the three take turns; each still pass by pass.
+  for (std::size_t i = 0; i < handed.size(); ++i) EXPECT_EQ(handed[i].frame, static_cast<int>(i % 3)) << i;
+  std::map<int, int> last_pass;
+  for (const auto& h : handed) {
+    EXPECT_GE(h.pass, last_pass[h.frame]);
+    last_pass[h.frame] = h.pass;
+  }
+}
+
+// A group is one tenant of the fair share: two frames of a timelapse and a
+// plain job of the same priority get half the units each.
+TEST(TimelapseScheduling, AGroupCountsAsOneTenant) {
+  JobService service(fresh_dir("tenant"));
+  const std::string a = service.submit(api::parse_render_request(frame_request(1)), std::nullopt).id;
+  const std::string b = service.submit(api::parse_render_request(frame_request(2)), std::nullopt).id;
+  ASSERT_TRUE(service.set_group(a, "timelapse-c"));
+  ASSERT_TRUE(service.set_group(b, "timelapse-c"));
+  const std::string plain = service.submit(api::parse_render_request(frame_request(3)), std::nullopt).id;
+  int to_plain = 0;
+  for (int i = 0; i < 8; ++i) {
+    const auto u = service.next_unit("w0");
+    ASSERT_TRUE(u);
+    to_plain += u->key.job_id == plain;
+  }
+  EXPECT_EQ(to_plain, 4);
 }
 
 TEST(TimelapseScheduling, RequeuedUnitsOfALostWorkerGoFirst) {
