@@ -30,8 +30,9 @@ using HandlerResponse = httplib::Server::HandlerResponse;
 
 // --- Server settings -------------------------------------------------------
 // cpp-httplib 0.11 serves each connection on one thread of a fixed pool for
-// the connection's whole life, so every setting below bounds how long a
-// client can hold a thread:
+// the connection's whole life; GatedHttpServer (server/http_gate.h) holds a
+// connection without a thread until its request has arrived, under the
+// header and body deadlines, and the settings below bound the rest:
 // - read timeout 10 s: one recv() of a request line, header or body chunk may
 //   wait this long (a slow but live uploader on a bad link still gets
 //   through; a stalled one is dropped);
@@ -39,7 +40,7 @@ using HandlerResponse = httplib::Server::HandlerResponse;
 //   stream is dropped after this long without progress;
 // - keep-alive: up to 100 requests per connection (0.11's default of 5 makes
 //   pollers reconnect all the time), but an idle connection is closed after
-//   3 s: it holds a pool thread while it waits, and a poller of 1-2 s still
+//   3 s (it holds a file descriptor meanwhile), and a poller of 1-2 s still
 //   reuses its connection;
 // - TCP_NODELAY: event frames and small JSON answers leave at once instead
 //   of waiting for Nagle + delayed ACK (up to 40 ms);

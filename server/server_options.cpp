@@ -12,13 +12,19 @@ const char* const kServerUsage =
     "                      [--max-active-jobs N] [--max-queue-units N] [--max-body-bytes N]\n"
     "                      [--probe-timeout SECONDS (default 120)] [--sky-cache-mb N (default 256)]\n"
     "                      [--envmap-cache-mb N (default 128)] [--ffmpeg PATH] [--max-timelapse-frames N]\n"
+    "                      [--header-timeout SECONDS (default 10)] [--body-timeout SECONDS (default 30)]\n"
+    "                      [--max-connections N (default 1024)]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
     "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT,\n"
-    "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB, SKYFARM_FFMPEG, SKYFARM_MAX_TIMELAPSE_FRAMES).\n"
+    "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB, SKYFARM_FFMPEG, SKYFARM_MAX_TIMELAPSE_FRAMES,\n"
+    "SKYFARM_HEADER_TIMEOUT, SKYFARM_BODY_TIMEOUT, SKYFARM_MAX_CONNECTIONS).\n"
     "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
     "--sky-cache-mb, --envmap-cache-mb: MiB of LUT sky tables and of encoded env maps kept in memory\n"
     "for GET /v1/sky and /v1/sky/envmap.exr (least recently used evicted first; 0 keeps none).\n"
+    "--header-timeout, --body-timeout: a client must send its whole request head (body) within this\n"
+    "many seconds, else 408 and the connection is closed; slow clients hold no server thread meanwhile.\n"
+    "--max-connections: HTTP connections open at once; one beyond is answered 503 and closed.\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n";
 
 namespace {
@@ -41,10 +47,15 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--sky-cache-mb", "SKYFARM_SKY_CACHE_MB"},
                            {"--envmap-cache-mb", "SKYFARM_ENVMAP_CACHE_MB"},
                            {"--ffmpeg", "SKYFARM_FFMPEG"},
-                           {"--max-timelapse-frames", "SKYFARM_MAX_TIMELAPSE_FRAMES"}};
+                           {"--max-timelapse-frames", "SKYFARM_MAX_TIMELAPSE_FRAMES"},
+                           {"--header-timeout", "SKYFARM_HEADER_TIMEOUT"},
+                           {"--body-timeout", "SKYFARM_BODY_TIMEOUT"},
+                           {"--max-connections", "SKYFARM_MAX_CONNECTIONS"}};
 
 constexpr long long kMaxCacheMb = 1 << 20;  // 1 TiB: a typo guard, not a memory check
 constexpr double kMaxProbeTimeoutS = 3600.0;
+constexpr double kMaxRequestTimeoutS = 3600.0;  // --header-timeout, --body-timeout
+constexpr long long kMaxConnections = 1000000;
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
@@ -59,14 +70,18 @@ std::string set_sizes_and_timeouts(const std::string& flag, const std::string& v
   try {
     if (flag == "--sky-cache-mb" || flag == "--envmap-cache-mb") {
       (flag == "--sky-cache-mb" ? o->sky_cache_mb : o->envmap_cache_mb) = whole_number(value, 0, kMaxCacheMb);
-    } else if (flag == "--probe-timeout") {
+    } else if (flag == "--probe-timeout" || flag == "--header-timeout" || flag == "--body-timeout") {
       std::size_t used = 0;
       const double s = std::stod(value, &used);
-      if (used != value.size() || !(s > 0.0 && s <= kMaxProbeTimeoutS)) throw std::invalid_argument("range");
-      o->probe_timeout_s = s;
+      const double max = flag == "--probe-timeout" ? kMaxProbeTimeoutS : kMaxRequestTimeoutS;
+      if (used != value.size() || !(s > 0.0 && s <= max)) throw std::invalid_argument("range");
+      (flag == "--probe-timeout" ? o->probe_timeout_s : flag == "--header-timeout" ? o->header_timeout_s : o->body_timeout_s) = s;
+    } else if (flag == "--max-connections") {
+      o->max_connections = static_cast<int>(whole_number(value, 1, kMaxConnections));
     }
   } catch (const std::exception&) {
-    if (flag == "--probe-timeout") return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
+    if (flag == "--max-connections") return flag + ": invalid value '" + value + "' (a whole number in [1, 1000000])";
+    if (flag.ends_with("-timeout")) return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
     return flag + ": invalid value '" + value + "' (a whole number of MiB in [0, 1048576])";
   }
   return "";

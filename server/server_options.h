@@ -17,6 +17,13 @@
 //                               (SKYFARM_ENVMAP_CACHE_MB)
 //   --ffmpeg PATH               ffmpeg for timelapse videos; default: ffmpeg on PATH (SKYFARM_FFMPEG)
 //   --max-timelapse-frames N    frames per timelapse, 400 beyond; default 1000 (SKYFARM_MAX_TIMELAPSE_FRAMES)
+//   --header-timeout S          a request head must arrive within S seconds (from the first byte, or
+//                               the previous response's end); 408 and closed beyond; (0, 3600],
+//                               default 10 (SKYFARM_HEADER_TIMEOUT)
+//   --body-timeout S            a request body must arrive within S seconds after its head; (0, 3600],
+//                               default 30 (SKYFARM_BODY_TIMEOUT)
+//   --max-connections N         HTTP connections open at once, 503 and closed beyond; [1, 1000000],
+//                               default 1024 (SKYFARM_MAX_CONNECTIONS)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -41,6 +48,9 @@ struct ServerOptions {
   long long envmap_cache_mb = 128;
   std::string ffmpeg;              // "": ffmpeg on PATH
   int max_timelapse_frames = 1000;
+  double header_timeout_s = 10.0;
+  double body_timeout_s = 30.0;
+  int max_connections = 1024;
   bool help = false;
 };
 
