@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <deque>
@@ -76,13 +77,17 @@ std::string_view trim(std::string_view s) {
 
 // What the gate needs to know of a request head to decide how long to hold it.
 struct HeadFraming {
-  bool body_on_thread = false;  // chunked, Expect, odd or repeated Content-Length: read on the thread
+  // Expect, another transfer coding, odd or repeated Content-Length: the body
+  // is read on the thread (httplib answers what is wrong with it).
+  bool body_on_thread = false;
+  bool chunked = false;
   std::uint64_t content_length = 0;
 };
 
 HeadFraming framing_of(std::string_view head) {
   HeadFraming f;
   int lengths = 0;
+  int codings = 0;
   std::size_t at = head.find("\r\n");  // skip the request line
   while (at != std::string_view::npos && at + 2 < head.size()) {
     const std::size_t start = at + 2;
@@ -93,7 +98,10 @@ HeadFraming framing_of(std::string_view head) {
     if (colon == std::string_view::npos) continue;
     const std::string_view name = trim(line.substr(0, colon));
     const std::string_view value = trim(line.substr(colon + 1));
-    if (iequals(name, "Transfer-Encoding") || iequals(name, "Expect")) {
+    if (iequals(name, "Transfer-Encoding")) {
+      ++codings;
+      f.chunked = iequals(value, "chunked");
+    } else if (iequals(name, "Expect")) {
       f.body_on_thread = true;
     } else if (iequals(name, "Content-Length")) {
       ++lengths;
@@ -107,8 +115,43 @@ HeadFraming framing_of(std::string_view head) {
       f.content_length = n;
     }
   }
-  if (lengths > 1) f.body_on_thread = true;
+  if (lengths > 1 || codings > 1 || (codings == 1 && (!f.chunked || lengths > 0))) f.body_on_thread = true;
   return f;
+}
+
+// Where a chunked body ends in `data`, scanning from `pos` (the start of a
+// chunk-size line, advanced past whole chunks).  0: not all there yet;
+// npos: malformed or its chunks exceed `limit` bytes (left to the thread).
+constexpr std::size_t kMaxChunkLine = 1024;
+
+std::size_t chunked_end(std::string_view data, std::size_t& pos, std::size_t& total, std::size_t limit) {
+  for (;;) {
+    const std::size_t eol = data.find("\r\n", pos);
+    if (eol == std::string_view::npos) return data.size() - pos > kMaxChunkLine ? std::string_view::npos : 0;
+    std::string_view line = data.substr(pos, eol - pos);
+    if (const std::size_t semi = line.find(';'); semi != std::string_view::npos) line = line.substr(0, semi);
+    line = trim(line);
+    std::size_t size = 0;
+    if (line.empty() || line.size() > 8) return std::string_view::npos;
+    for (char c : line) {
+      const int d = std::isxdigit(static_cast<unsigned char>(c)) ? (std::isdigit(static_cast<unsigned char>(c)) ? c - '0' : (std::tolower(c) - 'a' + 10)) : -1;
+      if (d < 0) return std::string_view::npos;
+      size = size * 16 + static_cast<std::size_t>(d);
+    }
+    if (size == 0) {  // the last chunk, then trailer lines up to an empty one
+      for (std::size_t at = eol + 2;;) {
+        const std::size_t end = data.find("\r\n", at);
+        if (end == std::string_view::npos) return data.size() - at > kMaxChunkLine ? std::string_view::npos : 0;
+        if (end == at) return end + 2;
+        at = end + 2;
+      }
+    }
+    total += size;
+    if (total > limit) return std::string_view::npos;
+    const std::size_t next = eol + 2 + size + 2;
+    if (data.size() < next) return 0;
+    pos = next;
+  }
 }
 
 void close_socket(int fd) {
@@ -131,6 +174,9 @@ struct Connection {
   bool head_deadline_set = false;
   Clock::time_point body_deadline;  // set when the head is complete
   std::size_t needed = 0;           // bytes of pending that make the request (head + body)
+  bool chunked = false;             // the body's end is found by chunked_end
+  std::size_t chunk_pos = 0;        // chunked_end's place and body bytes so far
+  std::size_t chunk_total = 0;
   std::size_t reserved = 0;         // of the gate's buffer budget
   std::size_t requests = 0;         // served on this connection
 };
@@ -390,6 +436,7 @@ class ConnectionGate {
     c->phase = Connection::Phase::kIdle;
     c->scanned = 0;
     c->needed = 0;
+    c->chunked = false;
     c->idle_deadline = now + server_.keep_alive_timeout();
     c->head_deadline_set = c->requests > 0;  // a keep-alive head counts from the response's end
     if (c->head_deadline_set) c->head_deadline = now + options_.header_timeout;
@@ -452,13 +499,27 @@ class ConnectionGate {
       const std::size_t head = end + 4;
       const HeadFraming f = framing_of(std::string_view(c.pending).substr(0, head));
       c.body_deadline = now + options_.body_timeout;
-      if (f.body_on_thread || f.content_length > options_.max_buffered_body ||
-          !reserve(c, static_cast<std::size_t>(f.content_length))) {
+      // A chunked body may reach max_buffered_body: that much is reserved.
+      const std::size_t reserve_bytes = f.chunked ? options_.max_buffered_body : static_cast<std::size_t>(f.content_length);
+      if (f.body_on_thread || f.content_length > options_.max_buffered_body || !reserve(c, reserve_bytes)) {
         dispatch(it);
         return;
       }
       c.phase = Connection::Phase::kBody;
       c.needed = head + static_cast<std::size_t>(f.content_length);
+      c.chunked = f.chunked;
+      c.chunk_pos = head;
+      c.chunk_total = 0;
+    }
+    if (c.chunked) {
+      const std::size_t end = chunked_end(c.pending, c.chunk_pos, c.chunk_total, options_.max_buffered_body);
+      // Tiny chunks cost framing bytes too: past twice the limit, the thread reads on.
+      if (end == 0 && c.pending.size() <= 2 * options_.max_buffered_body + kMaxHeadBytes) {
+        c.needed = c.pending.size() + 1;  // read on, but not without bound
+        return;
+      }
+      dispatch(it);  // complete, or left to httplib's own answer
+      return;
     }
     if (c.pending.size() >= c.needed) dispatch(it);
   }

@@ -8,11 +8,11 @@
 // dozen such clients stall the whole API.  Here a connection holds no thread
 // while its request arrives:
 //   accept (httplib's own loop) -> the gate (epoll, no thread per connection)
-//     until the head ends ("\r\n\r\n") and, for a Content-Length body within
-//     max_buffered_body, until the body is in too
+//     until the head ends ("\r\n\r\n") and, for a body (Content-Length or
+//     chunked) within max_buffered_body, until the body is in too
 //   -> a pool thread runs httplib's request processing on the bytes read, and
-//     reads any rest of the body (chunked, larger, or after "Expect:
-//     100-continue") under the body deadline
+//     reads any rest of the body (larger, or after "Expect: 100-continue")
+//     under the body deadline
 //   -> after the response, a keep-alive connection goes back to the gate.
 // Responses (event streams, long probe waits) are not bounded here: the
 // deadlines cover only what the client sends.
@@ -26,8 +26,8 @@
 //                      then 408 (when no response has started) and closed
 //   max_connections    connections open at once (waiting or being served);
 //                      one beyond is answered 503 at once and closed
-//   max_buffered_body  Content-Length bodies up to this size wait in the gate
-//                      (no thread); larger ones are read on a pool thread
+//   max_buffered_body  bodies up to this size wait in the gate (no thread);
+//                      larger ones are read on a pool thread
 //   buffer_budget      bytes the gate may hold for all waiting bodies; beyond,
 //                      bodies are read on a pool thread
 // A connection silent before its first byte is closed after httplib's

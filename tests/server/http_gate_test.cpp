@@ -16,6 +16,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -23,6 +24,7 @@
 
 #include "tests/server/fake_backend.h"
 #include "tests/support/http_fixture.h"
+#include "tests/support/test_files.h"
 
 namespace skyfarm::server {
 namespace {
@@ -176,7 +178,7 @@ TEST_F(HttpGateTest, SlowBodyIsCutAtTheBodyDeadline) {
   EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
 }
 
-// A chunked body is read on a pool thread, under the same deadline.
+// A chunked body waits in the gate too.
 TEST_F(HttpGateTest, SlowChunkedBodyIsCutAtTheBodyDeadline) {
   start(30s, 1s);
   const int fd = connect_loopback(port_);
@@ -192,6 +194,24 @@ TEST_F(HttpGateTest, SlowChunkedBodyIsCutAtTheBodyDeadline) {
   auto r = client().Get("/healthz");
   ASSERT_TRUE(r);
   EXPECT_EQ(r->status, 200);
+}
+
+// A body larger than the gate holds is read on a pool thread, under the
+// same deadline, and the thread is free again after it.
+TEST_F(HttpGateTest, SlowLargeBodyIsCutOnThePoolThread) {
+  gate_.max_buffered_body = 16;
+  start(30s, 1s);
+  const int fd = connect_loopback(port_);
+  ASSERT_GE(fd, 0);
+  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
+                           "Content-Length: 100\r\n\r\n"));
+  const Trickle t = trickle(fd, std::string(100, ' '));
+  ::close(fd);
+  EXPECT_TRUE(t.closed) << "still open after " << t.sent << " body bytes";
+  EXPECT_LT(t.sent, kSlowBytesMax);
+  EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
+  for (int i = 0; i < 300 && server_->open_connections() > 0; ++i) std::this_thread::sleep_for(10ms);
+  EXPECT_EQ(server_->open_connections(), 0);
 }
 
 // On a keep-alive connection the next head is due within the deadline
@@ -320,6 +340,29 @@ TEST_F(HttpGateTest, FastClientsKeepTheirConnection) {
   }
   for (int i = 0; i < 300 && server_->open_connections() > 1; ++i) std::this_thread::sleep_for(10ms);
   EXPECT_EQ(server_->open_connections(), 1);
+}
+
+// A chunked body that arrives in pieces (chunks split, an extension) is
+// served whole once its last chunk is in.
+TEST_F(HttpGateTest, ChunkedBodiesArrivingInPiecesAreServed) {
+  start(5s, 5s);
+  const std::string body = skyfarm::testing::read_text(skyfarm::testing::kExamples / "noon_fisheye.json");
+  std::ostringstream wire;
+  wire << std::hex << 10 << ";ext=1\r\n" << body.substr(0, 10) << "\r\n" << body.size() - 10 << "\r\n"
+       << body.substr(10) << "\r\n0\r\n\r\n";
+  const std::string chunks = wire.str();
+  const int fd = connect_loopback(port_);
+  ASSERT_GE(fd, 0);
+  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
+                           "Transfer-Encoding: chunked\r\n\r\n"));
+  for (std::size_t at = 0; at < chunks.size(); at += 7) {
+    ASSERT_TRUE(send_all(fd, std::string_view(chunks).substr(at, 7)));
+    if (at % 70 == 0) std::this_thread::sleep_for(20ms);
+  }
+  const std::string answer = read_response(fd);
+  ::close(fd);
+  EXPECT_TRUE(answer.starts_with("HTTP/1.1 202 ")) << answer;
+  EXPECT_EQ(backend_.submissions().size(), 1u);
 }
 
 }  // namespace
