@@ -311,7 +311,7 @@ TEST_F(HttpGateTest, EventStreamsOutliveTheDeadlines) {
 }
 
 TEST_F(HttpGateTest, FastClientsKeepTheirConnection) {
-  start(1s, 1s);
+  start(2s, 2s);
   // Sequential requests on one connection, spaced less than the deadlines apart.
   const int fd = connect_loopback(port_);
   ASSERT_GE(fd, 0);
