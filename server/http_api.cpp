@@ -11,6 +11,7 @@
 #include "api/render_request.h"
 #include "server/http_checks.h"
 #include "server/http_files.h"
+#include "server/http_gate.h"
 #include "server/http_openapi.h"
 #include "server/http_probe.h"
 #include "server/http_query.h"
@@ -204,6 +205,7 @@ HttpApi::HttpApi(HttpBackend& backend, HttpOptions options)
 HttpApi::~HttpApi() = default;
 
 void HttpApi::register_routes(httplib::Server& server) {
+  gate_ = dynamic_cast<const GatedHttpServer*>(&server);
   configure_server(server);
   add_routes(server);
   add_fallbacks(server);
@@ -479,6 +481,7 @@ void HttpApi::metrics(const Request&, Response& res) {
   std::string text = prometheus_text(backend_.metrics(), responses_, open_streams());
   append_sky_cache_metrics(text, sky_->service().stats());
   if (options_.probes) append_probe_metrics(text, options_.probes->stats());
+  if (gate_) append_gate_metrics(text, gate_->stats());
   res.set_content(std::move(text), kPrometheusContentType);
 }
 

@@ -73,6 +73,7 @@ struct Response;
 
 namespace skyfarm::server {
 
+class GatedHttpServer;
 class SkyHttp;
 class TimelapseHttp;
 class TimelapseService;
@@ -160,6 +161,7 @@ class HttpApi {
   ResponseCounter responses_;
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
+  const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
 };
 
 }  // namespace skyfarm::server

@@ -187,9 +187,9 @@ struct Connection {
 class GatedStream : public httplib::Stream {
  public:
   GatedStream(Connection& c, std::chrono::microseconds read_timeout, std::chrono::microseconds write_timeout,
-              Clock::time_point deadline, const std::string& timeout_response)
+              Clock::time_point deadline, const std::string& timeout_response, std::atomic<std::uint64_t>& timeouts)
       : c_(c), read_timeout_(read_timeout), write_timeout_(write_timeout), deadline_(deadline),
-        timeout_response_(timeout_response) {}
+        timeout_response_(timeout_response), timeouts_(timeouts) {}
 
   bool is_readable() const override {
     if (offset_ < c_.pending.size()) return true;
@@ -279,6 +279,7 @@ class GatedStream : public httplib::Stream {
   void expire() {
     if (!wrote_) send_best_effort(c_.fd, timeout_response_);
     dead_ = true;
+    timeouts_.fetch_add(1);
   }
 
   template <class F>
@@ -304,6 +305,7 @@ class GatedStream : public httplib::Stream {
   const std::chrono::microseconds write_timeout_;
   const Clock::time_point deadline_;
   const std::string& timeout_response_;
+  std::atomic<std::uint64_t>& timeouts_;
   std::size_t offset_ = 0;
   bool wrote_ = false;
   bool dead_ = false;
@@ -339,6 +341,7 @@ class ConnectionGate {
   // From httplib's accept loop: take the socket, or refuse it at the cap.
   void admit(int fd) {
     if (server_.open_.fetch_add(1) >= options_.max_connections) {
+      server_.refused_.fetch_add(1);
       send_best_effort(fd, busy_response_);
       close_socket(fd);
       server_.open_.fetch_sub(1);
@@ -543,10 +546,16 @@ class ConnectionGate {
           if (now >= c.idle_deadline || (c.head_deadline_set && now >= c.head_deadline)) drop(it);
           break;
         case Connection::Phase::kHead:
-          if (now >= c.head_deadline) refuse(it, head_timeout_response_);
+          if (now >= c.head_deadline) {
+            server_.head_timeouts_.fetch_add(1);
+            refuse(it, head_timeout_response_);
+          }
           break;
         case Connection::Phase::kBody:
-          if (now >= c.body_deadline) refuse(it, body_timeout_response_);
+          if (now >= c.body_deadline) {
+            server_.body_timeouts_.fetch_add(1);
+            refuse(it, body_timeout_response_);
+          }
           break;
       }
       it = next;
@@ -580,7 +589,7 @@ class ConnectionGate {
     bool dead = false;
     {
       GatedStream stream(*c, server_.read_timeout(), server_.write_timeout(), c->body_deadline,
-                         body_timeout_response_);
+                         body_timeout_response_, server_.body_timeouts_);
       try {
         ok = server_.serve_one(stream, last, closed);
       } catch (...) {  // httplib answers handler exceptions; anything else ends the connection
@@ -660,6 +669,28 @@ bool GatedHttpServer::listen(const std::string& host, int port, int socket_flags
 }
 
 int GatedHttpServer::open_connections() const { return open_.load(); }
+
+GateStats GatedHttpServer::stats() const {
+  GateStats s;
+  s.open = open_.load();
+  s.refused = refused_.load();
+  s.head_timeouts = head_timeouts_.load();
+  s.body_timeouts = body_timeouts_.load();
+  return s;
+}
+
+void append_gate_metrics(std::string& out, const GateStats& s) {
+  out += "# HELP skyfarm_http_connections_open HTTP connections open (waiting for their request or served).\n"
+         "# TYPE skyfarm_http_connections_open gauge\n"
+         "skyfarm_http_connections_open " + std::to_string(s.open) + "\n";
+  out += "# HELP skyfarm_http_connections_refused_total HTTP connections refused at the connection cap (503).\n"
+         "# TYPE skyfarm_http_connections_refused_total counter\n"
+         "skyfarm_http_connections_refused_total " + std::to_string(s.refused) + "\n";
+  out += "# HELP skyfarm_http_request_timeouts_total Requests whose head or body missed its deadline (408).\n"
+         "# TYPE skyfarm_http_request_timeouts_total counter\n"
+         "skyfarm_http_request_timeouts_total{part=\"head\"} " + std::to_string(s.head_timeouts) + "\n"
+         "skyfarm_http_request_timeouts_total{part=\"body\"} " + std::to_string(s.body_timeouts) + "\n";
+}
 
 bool GatedHttpServer::process_and_close_socket(socket_t sock) {
   if (ConnectionGate* gate = gate_.load()) {

@@ -44,8 +44,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 namespace skyfarm::server {
 
@@ -56,6 +58,18 @@ struct GateOptions {
   std::size_t max_buffered_body = 1 << 20;
   std::size_t buffer_budget = std::size_t{64} << 20;
 };
+
+// What /metrics shows of the gate.
+struct GateStats {
+  int open = 0;                    // connections open now
+  std::uint64_t refused = 0;       // beyond max_connections (503)
+  std::uint64_t head_timeouts = 0; // 408 for a late head
+  std::uint64_t body_timeouts = 0; // 408 for a late body
+};
+
+// Appends the gate's Prometheus metrics: skyfarm_http_connections_open,
+// skyfarm_http_connections_refused_total, skyfarm_http_request_timeouts_total{part}.
+void append_gate_metrics(std::string& out, const GateStats& stats);
 
 class ConnectionGate;
 
@@ -70,6 +84,7 @@ class GatedHttpServer : public httplib::Server {
 
   // Connections open now (waiting in the gate or being served).
   int open_connections() const;
+  GateStats stats() const;
 
  private:
   friend class ConnectionGate;
@@ -89,6 +104,9 @@ class GatedHttpServer : public httplib::Server {
   std::function<httplib::TaskQueue*()> pool_factory_;
   std::atomic<ConnectionGate*> gate_{nullptr};
   std::atomic<int> open_{0};
+  std::atomic<std::uint64_t> refused_{0};
+  std::atomic<std::uint64_t> head_timeouts_{0};
+  std::atomic<std::uint64_t> body_timeouts_{0};
 };
 
 }  // namespace skyfarm::server

@@ -148,6 +148,10 @@ class HttpGateTest : public testing::HttpFixture {
     gate_.body_timeout = body_timeout;
     serve(api_options());
   }
+  std::string metrics() {
+    auto r = client().Get("/metrics");
+    return r ? r->body : "";
+  }
 };
 
 const std::string kHealthz = "GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n";
@@ -162,6 +166,7 @@ TEST_F(HttpGateTest, SlowHeadIsCutAtTheHeaderDeadline) {
   EXPECT_LT(t.sent, kSlowBytesMax);
   EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
   EXPECT_NE(t.received.find("application/problem+json"), std::string::npos);
+  EXPECT_NE(metrics().find("skyfarm_http_request_timeouts_total{part=\"head\"} 1\n"), std::string::npos);
 }
 
 // A Content-Length body small enough to wait in the gate.
@@ -212,6 +217,7 @@ TEST_F(HttpGateTest, SlowLargeBodyIsCutOnThePoolThread) {
   EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
   for (int i = 0; i < 300 && server_->open_connections() > 0; ++i) std::this_thread::sleep_for(10ms);
   EXPECT_EQ(server_->open_connections(), 0);
+  EXPECT_NE(metrics().find("skyfarm_http_request_timeouts_total{part=\"body\"} 1\n"), std::string::npos);
 }
 
 // On a keep-alive connection the next head is due within the deadline
@@ -273,6 +279,7 @@ TEST_F(HttpGateTest, ConnectionCapRefusesTheOneBeyond) {
   ::close(beyond);
   EXPECT_TRUE(refused.starts_with("HTTP/1.1 503 ")) << refused;
   EXPECT_NE(refused.find("Retry-After: 1\r\n"), std::string::npos);
+  EXPECT_EQ(server_->stats().refused, 1u);
   // One leaves: a new client gets in.
   ::close(held.back());
   held.pop_back();
