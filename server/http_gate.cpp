@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <system_error>
 #include <thread>
 #include <unordered_map>
 #include <vector>
@@ -325,6 +326,13 @@ class ConnectionGate {
                                      "Retry-After: 1");
     epoll_ = ::epoll_create1(EPOLL_CLOEXEC);
     wake_ = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+    if (epoll_ < 0 || wake_ < 0) {
+      const int error = errno;
+      if (epoll_ >= 0) ::close(epoll_);
+      if (wake_ >= 0) ::close(wake_);
+      pool_->shutdown();
+      throw std::system_error(error, std::generic_category(), "HTTP connection gate");
+    }
     epoll_event ev{};
     ev.events = EPOLLIN;
     ev.data.fd = wake_;
@@ -564,6 +572,11 @@ class ConnectionGate {
 
   void refuse(Waiting::iterator it, const std::string& response) {
     send_best_effort(it->first, response);
+    // Closing with unread input would reset the connection, and the client
+    // could lose the answer: read off what is there now (bounded).
+    char buf[kRecvChunk];
+    for (int i = 0; i < 16 && ::recv(it->first, buf, sizeof buf, MSG_DONTWAIT) > 0; ++i) {
+    }
     drop(it);
   }
 

@@ -220,6 +220,19 @@ TEST_F(HttpGateTest, SlowLargeBodyIsCutOnThePoolThread) {
   EXPECT_NE(metrics().find("skyfarm_http_request_timeouts_total{part=\"body\"} 1\n"), std::string::npos);
 }
 
+// A head that never ends is refused once it outgrows what any request needs.
+TEST_F(HttpGateTest, EndlessHeadIsRefusedWith431) {
+  start(30s, 30s);
+  const int fd = connect_loopback(port_);
+  ASSERT_GE(fd, 0);
+  std::string head = "GET /healthz HTTP/1.1\r\n";
+  for (int i = 0; head.size() < 80 * 1024; ++i) head += "X-Filler-" + std::to_string(i) + ": " + std::string(100, 'x') + "\r\n";
+  send_all(fd, head);  // may fail part-way once the server has closed
+  const std::string answer = read_to_close(fd);
+  ::close(fd);
+  EXPECT_TRUE(answer.starts_with("HTTP/1.1 431 ")) << answer.substr(0, 200);
+}
+
 // On a keep-alive connection the next head is due within the deadline
 // counted from the end of the previous response.
 TEST_F(HttpGateTest, KeepAliveConnectionWithASlowNextHeadIsCut) {
