@@ -11,6 +11,7 @@
 #include "api/render_request.h"
 #include "server/http_checks.h"
 #include "server/http_files.h"
+#include "server/http_gate.h"
 #include "server/http_openapi.h"
 #include "server/http_probe.h"
 #include "server/http_query.h"
@@ -30,8 +31,9 @@ using HandlerResponse = httplib::Server::HandlerResponse;
 
 // --- Server settings -------------------------------------------------------
 // cpp-httplib 0.11 serves each connection on one thread of a fixed pool for
-// the connection's whole life, so every setting below bounds how long a
-// client can hold a thread:
+// the connection's whole life; GatedHttpServer (server/http_gate.h) holds a
+// connection without a thread until its request has arrived, under the
+// header and body deadlines, and the settings below bound the rest:
 // - read timeout 10 s: one recv() of a request line, header or body chunk may
 //   wait this long (a slow but live uploader on a bad link still gets
 //   through; a stalled one is dropped);
@@ -39,7 +41,7 @@ using HandlerResponse = httplib::Server::HandlerResponse;
 //   stream is dropped after this long without progress;
 // - keep-alive: up to 100 requests per connection (0.11's default of 5 makes
 //   pollers reconnect all the time), but an idle connection is closed after
-//   3 s: it holds a pool thread while it waits, and a poller of 1-2 s still
+//   3 s (it holds a file descriptor meanwhile), and a poller of 1-2 s still
 //   reuses its connection;
 // - TCP_NODELAY: event frames and small JSON answers leave at once instead
 //   of waiting for Nagle + delayed ACK (up to 40 ms);
@@ -203,6 +205,7 @@ HttpApi::HttpApi(HttpBackend& backend, HttpOptions options)
 HttpApi::~HttpApi() = default;
 
 void HttpApi::register_routes(httplib::Server& server) {
+  gate_ = dynamic_cast<const GatedHttpServer*>(&server);
   configure_server(server);
   add_routes(server);
   add_fallbacks(server);
@@ -508,6 +511,7 @@ void HttpApi::metrics(const Request&, Response& res) {
   std::string text = prometheus_text(figures, responses_, open_streams());
   append_sky_cache_metrics(text, sky_->service().stats());
   if (options_.probes) append_probe_metrics(text, options_.probes->stats());
+  if (gate_) append_gate_metrics(text, gate_->stats());
   res.set_content(std::move(text), kPrometheusContentType);
 }
 

@@ -73,6 +73,7 @@ struct Response;
 
 namespace skyfarm::server {
 
+class GatedHttpServer;
 class SkyHttp;
 class TimelapseHttp;
 class TimelapseService;
@@ -83,8 +84,9 @@ struct HttpOptions {
   int max_json_depth = 32;                   // 400 beyond (the request parser also checks 32)
   int max_concurrent_streams = 16;           // SSE streams; 503 + Retry-After beyond
   std::chrono::milliseconds sse_keepalive = std::chrono::seconds(10);  // ": keepalive" comment interval
-  // httplib pool threads; 0 = max_concurrent_streams + max(8, cores).  Each
-  // connection holds one for its lifetime (streams and keep-alive included).
+  // httplib pool threads; 0 = max_concurrent_streams + max(8, cores).  Behind
+  // GatedHttpServer (server/http_gate.h) a request holds one while it is
+  // served (an event stream for its whole life), not while it arrives.
   int http_threads = 0;
   // Called after every response (access logging); may be empty.
   std::function<void(const httplib::Request&, const httplib::Response&)> on_response;
@@ -162,6 +164,7 @@ class HttpApi {
   ResponseCounter responses_;
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
+  const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
 };
 
 }  // namespace skyfarm::server

@@ -14,6 +14,7 @@
 #include "common/render/parallel.h"
 #include "server/broker.h"
 #include "server/http_api.h"
+#include "server/http_gate.h"
 #include "server/job_service.h"
 #include "server/local_workers.h"
 #include "server/probe_router.h"
@@ -175,7 +176,13 @@ int main(int argc, char** argv) {
       return nlohmann::json{{"auth_failures", s.auth_failures}, {"results_refused", s.results_refused}};
     };
     HttpApi api(service, http_options);
-    httplib::Server http;
+    // Slow clients wait for their whole request in the gate, not on a thread (http_gate.h).
+    GateOptions gate;
+    gate.header_timeout = std::chrono::milliseconds(static_cast<long long>(options.header_timeout_s * 1000.0));
+    gate.body_timeout = std::chrono::milliseconds(static_cast<long long>(options.body_timeout_s * 1000.0));
+    gate.max_connections = options.max_connections;
+    gate.max_buffered_body = http_options.max_body_bytes;
+    GatedHttpServer http(gate);
     api.register_routes(http);
     // Port 0: any free port (printed below), for tests and side-by-side servers.
     const int bound_port = port == 0 ? http.bind_to_any_port(host.c_str()) : (http.bind_to_port(host.c_str(), port) ? port : -1);

@@ -15,18 +15,24 @@ const char* const kServerUsage =
     "                      [--envmap-cache-mb N (default 128)] [--ffmpeg PATH] [--max-timelapse-frames N]\n"
     "                      [--max-disk-mb N (default: 80 % of the free disk; 0 = no limit)]\n"
     "                      [--retention-hours H (default 168; 0 = never)]\n"
+    "                      [--header-timeout SECONDS (default 10)] [--body-timeout SECONDS (default 30)]\n"
+    "                      [--max-connections N (default 1024)]\n"
     "Every flag also reads SKYFARM_<NAME> from the environment (SKYFARM_LISTEN, SKYFARM_BROKER,\n"
     "SKYFARM_LOCAL_WORKERS, SKYFARM_DATA_DIR, SKYFARM_TOKEN, SKYFARM_WORKER_BINARY, SKYFARM_UNIT_TIMEOUT,\n"
     "SKYFARM_WORKER_SECRET_FILE, SKYFARM_WORKER_KEYS, SKYFARM_SERVER_KEY_FILE,\n"
     "SKYFARM_MAX_ACTIVE_JOBS, SKYFARM_MAX_QUEUE_UNITS, SKYFARM_MAX_BODY_BYTES, SKYFARM_PROBE_TIMEOUT,\n"
     "SKYFARM_SKY_CACHE_MB, SKYFARM_ENVMAP_CACHE_MB, SKYFARM_FFMPEG, SKYFARM_MAX_TIMELAPSE_FRAMES,\n"
-    "SKYFARM_MAX_DISK_MB, SKYFARM_RETENTION_HOURS).\n"
+    "SKYFARM_MAX_DISK_MB, SKYFARM_RETENTION_HOURS,\n"
+    "SKYFARM_HEADER_TIMEOUT, SKYFARM_BODY_TIMEOUT, SKYFARM_MAX_CONNECTIONS).\n"
     "--probe-timeout: seconds a POST /v1/sky/radiance path probe may take on the farm (then 504).\n"
     "--sky-cache-mb, --envmap-cache-mb: MiB of LUT sky tables and of encoded env maps kept in memory\n"
     "for GET /v1/sky and /v1/sky/envmap.exr (least recently used evicted first; 0 keeps none).\n"
     "--max-disk-mb: MiB the data directory may hold; a render whose tiles and images would not fit\n"
     "beside the others is refused with 507 (default: 80 % of the free space plus what it holds, at start).\n"
     "--retention-hours: finished renders' files are deleted this long after they finish (images then 410).\n"
+    "--header-timeout, --body-timeout: a client must send its whole request head (body) within this\n"
+    "many seconds, else 408 and the connection is closed; slow clients hold no server thread meanwhile.\n"
+    "--max-connections: HTTP connections open at once; one beyond is answered 503 and closed.\n"
     "Without a token the server listens on loopback only; give --token to listen beyond it.\n"
     "Workers authenticate with CURVE (the --token is for HTTP only): --worker-secret-file PATH (a shared\n"
     "secret, never sent; workers give --secret-file) and/or --worker-keys FILE|DIR (an allow-list of\n"
@@ -61,12 +67,16 @@ constexpr Flag kFlags[] = {{"--listen", "SKYFARM_LISTEN"},
                            {"--ffmpeg", "SKYFARM_FFMPEG"},
                            {"--max-timelapse-frames", "SKYFARM_MAX_TIMELAPSE_FRAMES"},
                            {"--max-disk-mb", "SKYFARM_MAX_DISK_MB"},
-                           {"--retention-hours", "SKYFARM_RETENTION_HOURS"}};
+                           {"--retention-hours", "SKYFARM_RETENTION_HOURS"},
+                           {"--header-timeout", "SKYFARM_HEADER_TIMEOUT"},
+                           {"--body-timeout", "SKYFARM_BODY_TIMEOUT"},
+                           {"--max-connections", "SKYFARM_MAX_CONNECTIONS"}};
 
 constexpr long long kMaxCacheMb = 1 << 20;  // 1 TiB: a typo guard, not a memory check
 constexpr double kMaxProbeTimeoutS = 3600.0;
 constexpr long long kMaxDiskMb = 1LL << 30;  // 1 EiB: a typo guard
 constexpr double kMaxRetentionHours = 1e6;
+constexpr double kMaxRequestTimeoutS = 3600.0;  // --header-timeout, --body-timeout
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
@@ -88,14 +98,18 @@ std::string set_sizes_and_timeouts(const std::string& flag, const std::string& v
       const double h = std::stod(value, &used);
       if (used != value.size() || !(h >= 0.0 && h <= kMaxRetentionHours)) throw std::invalid_argument("range");
       o->retention_hours = h;
-    } else if (flag == "--probe-timeout") {
+    } else if (flag == "--probe-timeout" || flag == "--header-timeout" || flag == "--body-timeout") {
       std::size_t used = 0;
       const double s = std::stod(value, &used);
-      if (used != value.size() || !(s > 0.0 && s <= kMaxProbeTimeoutS)) throw std::invalid_argument("range");
-      o->probe_timeout_s = s;
+      const double max = flag == "--probe-timeout" ? kMaxProbeTimeoutS : kMaxRequestTimeoutS;
+      if (used != value.size() || !(s > 0.0 && s <= max)) throw std::invalid_argument("range");
+      (flag == "--probe-timeout" ? o->probe_timeout_s : flag == "--header-timeout" ? o->header_timeout_s : o->body_timeout_s) = s;
+    } else if (flag == "--max-connections") {
+      o->max_connections = static_cast<int>(whole_number(value, 1, kMaxConnections));
     }
   } catch (const std::exception&) {
-    if (flag == "--probe-timeout") return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
+    if (flag == "--max-connections") return flag + ": invalid value '" + value + "' (a whole number in [1, 1000000])";
+    if (flag.ends_with("-timeout")) return flag + ": invalid value '" + value + "' (seconds in (0, 3600])";
     if (flag == "--max-disk-mb")
       return flag + ": invalid value '" + value + "' (a whole number of MiB in [0, 1073741824]; 0 = no limit)";
     if (flag == "--retention-hours")

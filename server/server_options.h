@@ -33,6 +33,13 @@
 //   --retention-hours H         finished renders' files are deleted H hours after they finish (the
 //                               record stays, "expired": true); default 168; 0 = never
 //                               (SKYFARM_RETENTION_HOURS)
+//   --header-timeout S          a request head must arrive within S seconds (from the first byte, or
+//                               the previous response's end); 408 and closed beyond; (0, 3600],
+//                               default 10 (SKYFARM_HEADER_TIMEOUT)
+//   --body-timeout S            a request body must arrive within S seconds after its head; (0, 3600],
+//                               default 30 (SKYFARM_BODY_TIMEOUT)
+//   --max-connections N         HTTP connections open at once, 503 and closed beyond; [1, 1000000],
+//                               default 1024 (SKYFARM_MAX_CONNECTIONS)
 // A flag beats its environment variable, which beats the default.
 #pragma once
 #include <optional>
@@ -62,6 +69,9 @@ struct ServerOptions {
   int max_timelapse_frames = 1000;
   long long max_disk_mb = -1;      // -1: sized to the machine at start
   double retention_hours = 168.0;  // 0: never
+  double header_timeout_s = 10.0;
+  double body_timeout_s = 30.0;
+  int max_connections = 1024;
   bool help = false;
 };
 

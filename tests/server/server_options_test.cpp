@@ -96,6 +96,37 @@ TEST(ServerOptions, CacheSizesAndProbeTimeout) {
   EXPECT_EQ(bad.sky_cache_mb, 256) << "a refused value changes nothing";
 }
 
+// The HTTP deadlines and the connection cap: defaults, flags, environment,
+// and bad values refused naming the flag and the range.
+TEST(ServerOptions, HttpDeadlinesAndConnectionCap) {
+  ServerOptions o;
+  ASSERT_EQ(parse_server_options({}, &o), "");
+  EXPECT_EQ(o.header_timeout_s, 10.0);
+  EXPECT_EQ(o.body_timeout_s, 30.0);
+  EXPECT_EQ(o.max_connections, 1024);
+  ::setenv("SKYFARM_BODY_TIMEOUT", "45", 1);
+  ::setenv("SKYFARM_MAX_CONNECTIONS", "99", 1);
+  ASSERT_EQ(parse_server_options({"--header-timeout", "2.5", "--max-connections", "200"}, &o), "");
+  ::unsetenv("SKYFARM_BODY_TIMEOUT");
+  ::unsetenv("SKYFARM_MAX_CONNECTIONS");
+  EXPECT_EQ(o.header_timeout_s, 2.5);
+  EXPECT_EQ(o.body_timeout_s, 45.0);
+  EXPECT_EQ(o.max_connections, 200);
+  ServerOptions bad;
+  EXPECT_EQ(parse_server_options({"--header-timeout", "0"}, &bad),
+            "--header-timeout: invalid value '0' (seconds in (0, 3600])");
+  EXPECT_EQ(parse_server_options({"--body-timeout", "1h"}, &bad),
+            "--body-timeout: invalid value '1h' (seconds in (0, 3600])");
+  EXPECT_EQ(parse_server_options({"--max-connections", "0"}, &bad),
+            "--max-connections: invalid value '0' (a whole number in [1, 1000000])");
+  ::setenv("SKYFARM_HEADER_TIMEOUT", "-1", 1);
+  EXPECT_EQ(parse_server_options({}, &bad),
+            "--header-timeout: invalid value '-1' (seconds in (0, 3600]) (from SKYFARM_HEADER_TIMEOUT)");
+  ::unsetenv("SKYFARM_HEADER_TIMEOUT");
+  EXPECT_EQ(bad.header_timeout_s, 10.0) << "a refused value changes nothing";
+  EXPECT_EQ(bad.max_connections, 1024);
+}
+
 }  // namespace
 }  // namespace skyfarm::server
 

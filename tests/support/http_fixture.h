@@ -1,5 +1,6 @@
 // A test fixture serving the HTTP API (server/http_api.h) over a fake job
-// backend on a free loopback port: start(options) binds and listens,
+// backend on a free loopback port, behind the connection gate
+// (server/http_gate.h, options in gate_): serve(options) binds and listens,
 // client() talks to it, TearDown stops it.
 #pragma once
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <thread>
 
 #include "server/http_api.h"
+#include "server/http_gate.h"
 #include "tests/server/fake_backend.h"
 
 namespace skyfarm::server::testing {
@@ -18,7 +20,7 @@ class HttpFixture : public ::testing::Test {
  protected:
   void serve(HttpOptions options) {
     api_ = std::make_unique<HttpApi>(backend_, std::move(options));
-    server_ = std::make_unique<httplib::Server>();
+    server_ = std::make_unique<GatedHttpServer>(gate_);
     api_->register_routes(*server_);
     port_ = server_->bind_to_any_port("127.0.0.1");
     ASSERT_GT(port_, 0);
@@ -39,7 +41,8 @@ class HttpFixture : public ::testing::Test {
 
   FakeBackend backend_;
   std::unique_ptr<HttpApi> api_;
-  std::unique_ptr<httplib::Server> server_;
+  GateOptions gate_;
+  std::unique_ptr<GatedHttpServer> server_;
   std::thread thread_;
   int port_ = 0;
   int read_timeout_s_ = 5;
