@@ -77,6 +77,7 @@ constexpr double kMaxProbeTimeoutS = 3600.0;
 constexpr long long kMaxDiskMb = 1LL << 30;  // 1 EiB: a typo guard
 constexpr double kMaxRetentionHours = 1e6;
 constexpr double kMaxRequestTimeoutS = 3600.0;  // --header-timeout, --body-timeout
+constexpr long long kMaxConnections = 1000000;
 
 // A whole decimal number in [lo, hi]; throws std::invalid_argument otherwise.
 long long whole_number(const std::string& value, long long lo, long long hi) {
