@@ -23,23 +23,11 @@ constexpr const char* kRequest = R"({
   "seed": 11
 })";
 
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("skyfarm_farm_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+fs::path fresh_dir(const std::string& name) { return testing::fresh_dir("skyfarm_farm", name); }
 
-// The local reference render of kRequest (computed once).
+// The local render of kRequest (computed once).
 const std::string& reference_exr() {
-  static const std::string bytes = [] {
-    const fs::path dir = fresh_dir("reference");
-    std::ofstream(dir / "request.json") << kRequest;
-    const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "request.json").string() +
-                            " -o " + (dir / "local.exr").string() + " > /dev/null 2>&1";
-    if (std::system(cmd.c_str()) != 0) return std::string();
-    return testing::read_text(dir / "local.exr");
-  }();
+  static const std::string bytes = testing::local_render_exr(kRequest, fresh_dir("reference"));
   return bytes;
 }
 

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -40,6 +41,25 @@ inline pid_t spawn_process(const std::vector<std::string>& args, const std::file
 inline std::string read_text(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+// A new, empty directory under the temporary folder: <prefix>_<name>_<pid>.
+inline std::filesystem::path fresh_dir(const std::string& prefix, const std::string& name) {
+  const std::filesystem::path d =
+      std::filesystem::temp_directory_path() / (prefix + "_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(d);
+  std::filesystem::create_directories(d);
+  return d;
+}
+
+// The EXR bytes of `skyfarm-worker render` of `request`, rendered in `dir`
+// (empty when the render failed): what a farm's image must equal.
+inline std::string local_render_exr(const std::string& request, const std::filesystem::path& dir) {
+  std::ofstream(dir / "request.json") << request;
+  const std::string cmd = std::string(SKYFARM_WORKER_BINARY) + " render " + (dir / "request.json").string() +
+                          " -o " + (dir / "local.exr").string() + " > /dev/null 2>&1";
+  if (std::system(cmd.c_str()) != 0) return std::string();
+  return read_text(dir / "local.exr");
 }
 
 inline void kill_and_wait(pid_t pid, int sig = SIGKILL) {
