@@ -9,8 +9,10 @@
 // before any tile gets its second pass, highest job priority first, FIFO
 // within a priority.  A result is merged into its tile only in canonical
 // (pass, batch) order; early results wait in memory.  Merged tiles are
-// written atomically to the data directory, so a restarted server resumes
-// from its merged passes and the final image is bit-identical to
+// written atomically to the data directory (each at most once a second while
+// it merges, and all of them before a job is done), so a restarted server
+// resumes from its merged passes (and hands out again what it merged after
+// the last write) and the final image is bit-identical to
 // `skyfarm-worker render`.
 #pragma once
 #include <chrono>
