@@ -1,7 +1,7 @@
 // skyfarm-farm-bench: the scheduler at scale, by simulation (farm_sim.h):
 // the real broker and job service with simulated workers that render nothing.
 //
-//   skyfarm-farm-bench [--workers 1000] [--units 100000] [--jobs 1] [--slots 2]
+//   skyfarm-farm-bench [--workers 1000] [--units 100000] [--jobs 1] [--slots 2] [--prefetch 16]
 //                      [--unit-ms 0] [--width 1] [--height 1] [--batches 64]
 //                      [--runs 1] [--timeout 600] [--data-dir DIR] [--json]
 //
@@ -9,6 +9,8 @@
 //   --units      units of work over all jobs (rounded up to whole passes)
 //   --jobs       jobs the units are shared among (submitted together)
 //   --slots      credit each worker announces in its READY
+//   --prefetch   units each worker accepts beyond its slots (READY "prefetch",
+//                default 16 as skyfarm-worker with 2 slots; 0: none)
 //   --unit-ms    simulated render time of a unit (0: answer at once)
 //   --width --height --batches   each job's request (tiny units by default:
 //                one pixel, 64 wavelength batches, 16-sample passes)
@@ -35,7 +37,7 @@ using skyfarm::server::FarmSimOptions;
 using skyfarm::server::FarmSimResult;
 
 constexpr const char* kUsage =
-    "usage: skyfarm-farm-bench [--workers N] [--units N] [--jobs N] [--slots N] [--unit-ms MS]\n"
+    "usage: skyfarm-farm-bench [--workers N] [--units N] [--jobs N] [--slots N] [--prefetch N] [--unit-ms MS]\n"
     "                          [--width W] [--height H] [--batches B] [--runs R] [--timeout S]\n"
     "                          [--data-dir DIR] [--json] [--log]\n";
 
@@ -115,6 +117,7 @@ int main(int argc, char** argv) {
       else if (a == "--units") o.units = integer(1, 1LL << 40);
       else if (a == "--jobs") o.jobs = static_cast<int>(integer(1, 10000));
       else if (a == "--slots") o.slots = static_cast<int>(integer(1, 1024));
+      else if (a == "--prefetch") o.prefetch = static_cast<int>(integer(0, 1024));
       else if (a == "--unit-ms") o.unit_ms = real();
       else if (a == "--width") o.width = static_cast<int>(integer(1, 65536));
       else if (a == "--height") o.height = static_cast<int>(integer(1, 65536));
@@ -139,9 +142,9 @@ int main(int argc, char** argv) {
   std::vector<FarmSimResult> results;
   bool ok = true;
   if (!json)
-    std::printf("farm simulation: %d workers x %d slots, %lld units in %d job(s), unit %.1f ms\n"
+    std::printf("farm simulation: %d workers x %d slots (+%d prefetch), %lld units in %d job(s), unit %.1f ms\n"
                 "%-8s %10s %9s %9s %9s %9s %9s %9s\n",
-                o.workers, o.slots, static_cast<long long>(o.units), o.jobs, o.unit_ms, "run", "units/s", "seconds",
+                o.workers, o.slots, o.prefetch, static_cast<long long>(o.units), o.jobs, o.unit_ms, "run", "units/s", "seconds",
                 "p50 ms", "p99 ms", "rss0 MB", "peak MB", "end MB");
   for (int r = 0; r < runs; ++r) {
     FarmSimResult res;
@@ -177,6 +180,7 @@ int main(int argc, char** argv) {
                                 {"all_done", ok},
                                 {"workers", o.workers},
                                 {"slots", o.slots},
+                                {"prefetch", o.prefetch},
                                 {"jobs", o.jobs},
                                 {"units", results.front().units_expected},
                                 {"unit_ms", o.unit_ms},

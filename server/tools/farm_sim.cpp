@@ -153,6 +153,7 @@ class SimWorkers {
     ready.id = w.id;
     ready.cores = 1;
     ready.slots = options_.slots;
+    ready.prefetch = options_.prefetch;
     ready.heartbeat_ms = kHeartbeatMs;
     send_frames(w.socket, api::encode(ready));
     w.credit_free.assign(static_cast<std::size_t>(options_.slots), SimClock::now());
@@ -291,6 +292,8 @@ FarmSimResult run_farm_sim(const FarmSimOptions& o) {
   if (o.units < o.jobs) throw std::runtime_error("--units must be at least --jobs");
   if (o.slots < 1 || o.slots > api::kMaxSlots)
     throw std::runtime_error("--slots must be in [1, " + std::to_string(api::kMaxSlots) + "]");
+  if (o.prefetch < 0 || o.prefetch > api::kMaxSlots)
+    throw std::runtime_error("--prefetch must be in [0, " + std::to_string(api::kMaxSlots) + "]");
   if (o.unit_ms < 0.0) throw std::runtime_error("--unit-ms must not be negative");
 
   // The requests: each job's share of the units, in whole passes.

@@ -6,6 +6,7 @@
 //   workers      simulated workers: ZeroMQ DEALER sockets served by the
 //                calling thread (zmq_poll over all of them), each speaking
 //                api/wire.h (READY, HEARTBEAT, RESULT) with `slots` credit
+//                and `prefetch` (the units it accepts beyond them)
 //   units        units of work in all, shared out over `jobs` jobs (each job
 //                a request of width x height pixels, `batches` wavelength
 //                batches and as many 16-sample passes as its share needs,
@@ -47,6 +48,7 @@ struct FarmSimOptions {
   std::int64_t units = 100000;
   int jobs = 1;
   int slots = 2;
+  int prefetch = 16;  // READY "prefetch", as skyfarm-worker announces it (8 x slots)
   double unit_ms = 0.0;
   int width = 1, height = 1, batches = 64;
   std::filesystem::path data_dir;
