@@ -104,8 +104,8 @@ struct ReadyMsg {
   int version = kProtocolVersion;
   nlohmann::json capabilities = nlohmann::json::object();  // e.g. {"spectral": true}
   int heartbeat_ms = 0;           // the worker's heartbeat interval (0: not told)
-  int prefetch = 0;               // units it queues beyond its slots (0: none)
   std::optional<std::string> token;
+  int prefetch = 0;               // units it queues beyond its slots (0: none)
   bool operator==(const ReadyMsg&) const = default;
 };
 

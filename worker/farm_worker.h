@@ -57,7 +57,7 @@ namespace skyfarm {
 struct FarmWorkerOptions {
   std::string endpoint = "tcp://127.0.0.1:5555";
   int threads = 0;     // render threads; 0 = all hardware threads
-  int slots = 0;       // units held at once (credit); 0 = threads + 1
+  int slots = 0;       // units held at once (credit); 0 = threads + 1, plus up to 8 x that queued for short units (READY prefetch)
   std::string token;   // shared secret sent in READY (empty: none)
   std::string id;      // empty: hostname-pid-random
   std::chrono::milliseconds heartbeat_interval{1000};

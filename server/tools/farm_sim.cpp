@@ -78,6 +78,7 @@ struct SimWorker {
   std::string id;
   bool joined = false;
   std::deque<SimClock::time_point> credit_free;  // when each free slot came free
+  SimClock::time_point busy_until{};             // its one core renders until then
 };
 
 struct PendingResult {
@@ -100,7 +101,7 @@ class SimWorkers {
   SimWorkers(const FarmSimOptions& options, const std::string& endpoint) : options_(options) {
     workers_.reserve(static_cast<std::size_t>(options.workers));
     for (int i = 0; i < options.workers; ++i) {
-      SimWorker w{zmq::socket_t(ctx_, zmq::socket_type::dealer), "sim-" + std::to_string(i), false, {}};
+      SimWorker w{zmq::socket_t(ctx_, zmq::socket_type::dealer), "sim-" + std::to_string(i), false, {}, {}};
       configure_sim_worker_socket(w.socket);
       w.socket.connect(endpoint);
       workers_.push_back(std::move(w));
@@ -192,8 +193,10 @@ class SimWorkers {
     if (options_.unit_ms <= 0.0) {
       send_result(i, frames);
     } else {
-      const auto due = now + std::chrono::duration_cast<SimClock::duration>(
-                                 std::chrono::duration<double, std::milli>(options_.unit_ms));
+      // One core: units render one after the other, in arrival order.
+      const auto due = std::max(now, w.busy_until) + std::chrono::duration_cast<SimClock::duration>(
+                                                         std::chrono::duration<double, std::milli>(options_.unit_ms));
+      w.busy_until = due;
       pending_.push(PendingResult{due, i, std::move(frames)});
     }
   }

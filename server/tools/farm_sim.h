@@ -12,7 +12,8 @@
 //                batches and as many 16-sample passes as its share needs,
 //                rounded up, so the figure reported is the plans' own count)
 //   unit_ms      how long a simulated worker "renders" a unit before it
-//                answers (0: at once, the scheduler alone is measured)
+//                answers, one unit at a time (one core; the others it holds
+//                wait), 0: at once, the scheduler alone is measured
 //   data_dir     the server's data directory (empty: a fresh temporary one,
 //                removed afterwards)
 //   timeout_s    gives up (all_done false) after this long
