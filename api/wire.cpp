@@ -142,6 +142,7 @@ Json header_of(const ReadyMsg& m) {
          {"slots", m.slots},     {"version", m.version},
          {"capabilities", m.capabilities.is_object() ? m.capabilities : Json::object()}};
   if (m.heartbeat_ms > 0) h["heartbeat_ms"] = m.heartbeat_ms;
+  if (m.prefetch > 0) h["prefetch"] = m.prefetch;
   if (m.token) h["token"] = *m.token;
   return h;
 }
@@ -197,6 +198,7 @@ ReadyMsg read_ready(const Json& h) {
     m.capabilities = *caps;
   }
   m.heartbeat_ms = static_cast<int>(get_int(h, "heartbeat_ms", 1, 3600 * 1000, false, 0));
+  m.prefetch = static_cast<int>(get_int(h, "prefetch", 0, kMaxSlots, false, 0));
   if (field(h, "token", false)) m.token = get_string(h, "token", 4096, true, true);
   return m;
 }

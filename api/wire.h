@@ -15,8 +15,8 @@
 //
 //   command     direction        header fields                                  payload
 //   READY       worker -> server id, cores, slots, version, capabilities,      -
-//                                heartbeat_ms?, token? (token: sent by workers
-//                                given --token, ignored: not a credential)
+//                                heartbeat_ms?, prefetch?, token? (token: sent by
+//                                workers given --token, ignored: not a credential)
 //   HEARTBEAT   both ways        heartbeat_ms? (sender's interval),            -
 //                                draining? (worker: send no more units)
 //   UNIT        server -> worker job, tile, batch, pass, attempt, request,     -
@@ -35,6 +35,14 @@
 // unit's index in api::probe_plan, batch = pass = 0) answered with
 // ProbeUnitSums bytes (common/render/probe_units.h); the server sends them
 // only to workers whose READY capabilities hold "probe": kProbeUnitsVersion.
+//
+// prefetch: units the worker accepts beyond its `slots`, queued behind the
+// ones it renders (absent or 0: none, the server sends at most `slots`).  The
+// server uses them only when units are short: it sizes each worker's credit
+// from the render time its RESULTs report so that the worker holds about the
+// broker's pipeline_target of work (server/broker.h), between `slots` and
+// `slots + prefetch`, so that tiny units do not leave a worker idle for a
+// round trip after each.  A field older peers ignore: no version change.
 //
 // samples_per_pass: [[even, odd], ...], an adaptive render's samples per
 // pixel in this pass for each allocation block of the tile (row-major) and
@@ -102,6 +110,7 @@ struct ReadyMsg {
   nlohmann::json capabilities = nlohmann::json::object();  // e.g. {"spectral": true}
   int heartbeat_ms = 0;           // the worker's heartbeat interval (0: not told)
   std::optional<std::string> token;
+  int prefetch = 0;               // units it queues beyond its slots (0: none)
   bool operator==(const ReadyMsg&) const = default;
 };
 

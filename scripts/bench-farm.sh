@@ -4,6 +4,8 @@
 #      skyfarm-worker render with N threads: wall times and their ratio (median of 3)
 #   2. scheduler throughput with tiny units (a 1x1 image, 4096 units of 16 paths)
 #   3. the server's peak memory (VmHWM) for a 4096x2048 job
+#   4. the scheduler at scale: 1000 simulated workers, 100000 tiny units
+#      (skyfarm-farm-bench, server/tools/farm_sim.h; median of 3 runs)
 # Usage: scripts/bench-farm.sh [N]   (N defaults to the number of cores)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -59,3 +61,7 @@ printf '{"bench":"scheduler_tiny_units","units":4096,"seconds":%.3f,"units_per_s
 t=$(submit_and_wait "$(request 4096 2048 1 1 5)")
 hwm=$(awk '/VmHWM/ {print $2}' "/proc/$server/status")
 printf '{"bench":"server_memory_4096x2048","seconds":%.1f,"server_peak_rss_mb":%.1f}\n' "$t" "$(echo "$hwm / 1024" | bc -l)"
+
+# 4. scale by simulation: the real broker and job service, 1000 simulated workers
+"$build/server/skyfarm-farm-bench" --workers 1000 --units 100000 --runs 3 --json | tail -1 |
+  sed 's/^{/{"bench":"farm_scale_simulated",/'

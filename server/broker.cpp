@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <set>
 #include <iostream>
@@ -60,13 +61,24 @@ struct Broker::Loop {
     std::string identity;  // ROUTER routing id
     std::string id;        // READY "id"
     int slots = 1;
+    int cores = 1;
+    int prefetch = 0;      // READY "prefetch": extra credit it accepts
+    double unit_s = -1.0;  // moving average of its RESULTs' render time (< 0: none yet)
+    int credit = 1;        // units it may hold now: slots, up to slots + prefetch
     bool draining = false;
     std::map<std::uint64_t, UnitKey> in_flight;  // attempt -> unit
     std::set<std::uint64_t> cancelled;           // attempts taken back by CANCEL, answers still possible
     Clock::duration expiry_span{};
     Clock::time_point expiry{};
     Clock::time_point last_heard{};
-    bool has_credit() const { return !draining && static_cast<int>(in_flight.size()) < slots; }
+    bool has_credit() const { return !draining && static_cast<int>(in_flight.size()) < credit; }
+    // The credit for about `target_s` of work on its cores.
+    void size_credit(double target_s) {
+      credit = slots;
+      if (prefetch <= 0 || unit_s < 0.0) return;
+      const double want = std::ceil(target_s * std::max(1, cores) / std::max(unit_s, 1e-6));
+      credit = static_cast<int>(std::clamp(want, static_cast<double>(slots), static_cast<double>(slots + prefetch)));
+    }
   };
 
   Loop(BrokerBackend& backend, const BrokerOptions& options, Shared& shared)
@@ -129,7 +141,9 @@ struct Broker::Loop {
   std::map<std::string, Worker> workers_;                  // by identity
   std::unordered_map<std::string, std::string> identity_of_;  // worker id -> identity
   std::size_t round_robin_ = 0;
-  Clock::time_point next_heartbeat_{}, next_timeout_check_{};
+  Clock::time_point next_heartbeat_{}, next_timeout_check_{}, next_dispatch_{};
+  bool dispatch_due_ = true;  // something may have made a unit or credit available
+  bool behind_ = false;       // the last receive_all left messages in the socket
 };
 
 // --- Loop: main -----------------------------------------------------------------
@@ -145,7 +159,10 @@ void Broker::Loop::run() {
                                {monitor_ ? monitor_->handle() : nullptr, -1, ZMQ_POLLIN, 0}};
     try {
       zmq::poll(items, zap_ ? 4 : 2, poll_timeout(Clock::now()));
-      if (items[1].revents & ZMQ_POLLIN) shared_.wakeup.drain();
+      if (items[1].revents & ZMQ_POLLIN) {
+        shared_.wakeup.drain();
+        dispatch_due_ = true;
+      }
       if (zap_ && (items[2].revents & ZMQ_POLLIN)) serve_zap();
       if (monitor_ && (items[3].revents & ZMQ_POLLIN)) read_monitor();
       if (items[0].revents & ZMQ_POLLIN) receive_all();
@@ -177,8 +194,13 @@ void Broker::Loop::housekeeping(Clock::time_point now) {
   if (now >= next_timeout_check_) {
     guarded("check_timeouts", [&] { backend_.check_timeouts(now); });
     next_timeout_check_ = now + options_.timeout_check_interval;
+    dispatch_due_ = true;
   }
-  dispatch();
+  if (dispatch_due_ || now >= next_dispatch_) {
+    dispatch_due_ = false;
+    next_dispatch_ = now + options_.poll_interval;
+    dispatch();
+  }
 }
 
 void Broker::Loop::shutdown() {
@@ -298,10 +320,14 @@ void Broker::Loop::send_or_lose(const std::string& identity, const api::Message&
 // --- Loop: receiving --------------------------------------------------------------
 
 void Broker::Loop::receive_all() {
-  // Bounded, so a flood cannot starve heartbeats and expiry.
+  // Bounded, so a flood cannot starve heartbeats and dispatch.
+  behind_ = true;
   for (int i = 0; i < 1000 && !shared_.stop.load(); ++i) {
     std::vector<zmq::message_t> parts;
-    if (!zmq::recv_multipart(router_, std::back_inserter(parts), zmq::recv_flags::dontwait)) return;
+    if (!zmq::recv_multipart(router_, std::back_inserter(parts), zmq::recv_flags::dontwait)) {
+      behind_ = false;
+      return;
+    }
     handle(parts);
   }
 }
@@ -394,6 +420,13 @@ bool Broker::Loop::fenced(Worker& w, const api::UnitRef& u, const char* what) {
 void Broker::Loop::handle_result(Worker& w, const api::ResultMsg& r) {
   if (!fenced(w, r.unit, "RESULT")) return;
   ++shared_.results;
+  // The fence took the attempt off the worker: its credit is sized from the
+  // render time it reports (a worker's own word, so only a sane one counts).
+  if (std::isfinite(r.seconds) && r.seconds >= 0.0) {
+    w.unit_s = w.unit_s < 0.0 ? r.seconds : 0.8 * w.unit_s + 0.2 * r.seconds;
+    w.size_credit(std::chrono::duration<double>(options_.pipeline_target).count());
+  }
+  dispatch_due_ = true;
   guarded("unit_done", [&] {
     backend_.unit_done(w.id, key_of(r.unit), r.unit.attempt, api::payload_bytes(r.film_tile), r.paths);
   });
@@ -402,6 +435,7 @@ void Broker::Loop::handle_result(Worker& w, const api::ResultMsg& r) {
 void Broker::Loop::handle_failed(Worker& w, const api::FailedMsg& f) {
   if (!fenced(w, f.unit, "FAILED")) return;
   ++shared_.failures;
+  dispatch_due_ = true;
   log("broker: worker " + w.id + " failed unit " + f.unit.job + "/" + std::to_string(f.unit.tile) + "/" +
       std::to_string(f.unit.batch) + "/" + std::to_string(f.unit.pass) + ": " + f.message);
   guarded("unit_failed", [&] { backend_.unit_failed(w.id, key_of(f.unit), f.unit.attempt, f.message); });
@@ -426,11 +460,15 @@ void Broker::Loop::register_worker(const std::string& identity, const api::Ready
   w.identity = identity;
   w.id = ready.id;
   w.slots = ready.slots;
+  w.cores = ready.cores;
+  w.prefetch = ready.prefetch;
+  w.credit = ready.slots;
   w.expiry_span = expiry_span(ready.heartbeat_ms);
   w.last_heard = Clock::now();
   w.expiry = w.last_heard + w.expiry_span;
   workers_[identity] = w;
   identity_of_[ready.id] = identity;
+  dispatch_due_ = true;
   ++shared_.workers;
   ++shared_.joined;
   nlohmann::json info{{"id", ready.id},
@@ -454,6 +492,7 @@ void Broker::Loop::remove_worker(const std::string& identity, const char* why, b
   if (const auto i = identity_of_.find(id); i != identity_of_.end() && i->second == identity) identity_of_.erase(i);
   --shared_.workers;
   ++shared_.left;
+  dispatch_due_ = true;  // its units are requeued
   if (lost) ++shared_.lost;
   log("broker: worker " + id + " left (" + why + ", " + std::to_string(held) + " units in flight)");
   guarded("worker_left", [&] { backend_.worker_left(id); });
@@ -470,6 +509,9 @@ void Broker::Loop::heartbeat_all() {
 }
 
 void Broker::Loop::expire(Clock::time_point now) {
+  // Behind on its input, the broker cannot tell a silent worker from one
+  // whose messages wait in the socket: a loaded broker must not drop live workers.
+  if (behind_) return;
   std::vector<std::string> expired;
   for (const auto& [identity, w] : workers_)
     if (w.expiry < now) expired.push_back(identity);
@@ -488,6 +530,7 @@ void Broker::Loop::send_cancels() {
     if (w.cancelled.size() >= kMaxCancelledRemembered) w.cancelled.erase(w.cancelled.begin());
     w.cancelled.insert(attempt);
     ++shared_.cancels_sent;
+    dispatch_due_ = true;
     send_or_lose(identity, api::CancelMsg{attempt});
   }
 }
@@ -497,15 +540,17 @@ void Broker::Loop::dispatch() {
   // take one or the backend has nothing for anyone.
   for (bool progress = true; progress && !shared_.stop.load();) {
     progress = false;
-    std::vector<std::string> ready;
-    for (const auto& [identity, w] : workers_)
-      if (w.has_credit()) ready.push_back(identity);
+    // Pointers into workers_ (a map: removing one worker leaves the others in place).
+    std::vector<Worker*> ready;
+    ready.reserve(workers_.size());
+    for (auto& [identity, w] : workers_)
+      if (w.has_credit()) ready.push_back(&w);
     if (ready.empty()) return;
     std::rotate(ready.begin(), ready.begin() + static_cast<std::ptrdiff_t>(round_robin_++ % ready.size()), ready.end());
-    for (const auto& identity : ready) {
-      const auto it = workers_.find(identity);
-      if (it == workers_.end() || !it->second.has_credit()) continue;
-      Worker& w = it->second;
+    for (Worker* wp : ready) {
+      Worker& w = *wp;
+      if (!w.has_credit()) continue;
+      const std::string& identity = w.identity;
       std::optional<UnitAssignment> unit;
       guarded("next_unit", [&] { unit = backend_.next_unit(w.id); });
       if (!unit) continue;
@@ -513,7 +558,8 @@ void Broker::Loop::dispatch() {
       api::UnitMsg msg{{unit->key.job_id, unit->key.tile, unit->key.batch, unit->key.pass, unit->attempt},
                        std::move(unit->request_canonical), unit->kind, std::move(unit->samples_per_pass)};
       if (!send(identity, msg)) {
-        remove_worker(identity, "unreachable", true);  // the backend requeues the unit
+        const std::string gone = identity;
+        remove_worker(gone, "unreachable", true);  // the backend requeues the unit
         continue;
       }
       ++shared_.units_sent;

@@ -27,11 +27,20 @@
 //               sent only while it has a free slot (backend.next_unit), one
 //               unit per worker per round-robin round.  RESULT, FAILED and
 //               CANCEL free a slot; a draining worker (HEARTBEAT
-//               "draining") gets no more units.
+//               "draining") gets no more units.  A worker that announces
+//               "prefetch" (api/wire.h) gets more credit when its units are
+//               short: enough for pipeline_target of work at the render time
+//               its RESULTs report (a moving average, over its cores), at most
+//               slots + prefetch, so tiny units do not idle it for a round
+//               trip after each.  Dispatch runs when credit came free, a
+//               worker joined or left, on wake(), after the timeout check,
+//               and otherwise every poll_interval.
 //   liveness    every message from the worker counts as a heartbeat; the
 //               broker heartbeats every worker each heartbeat_interval; a
 //               worker silent for heartbeat_liveness x max(own interval,
-//               worker's heartbeat_ms) is lost -> backend.worker_left.  So
+//               worker's heartbeat_ms) is lost -> backend.worker_left (not
+//               while the broker is behind on its input: that worker's
+//               messages may be waiting in the socket).  So
 //               are DISCONNECT and a send that fails (EHOSTUNREACH under
 //               ROUTER_MANDATORY, or EAGAIN at the high-water mark: sends
 //               never block).
@@ -81,6 +90,8 @@ struct BrokerOptions {
   // of dispatching work that appears without wake() (capped at heartbeat_interval).
   std::chrono::milliseconds poll_interval{20};
   std::chrono::milliseconds timeout_check_interval{250};
+  // Work a worker that announces "prefetch" should hold, in render time (see credit above).
+  std::chrono::milliseconds pipeline_target{100};
   std::chrono::milliseconds shutdown_linger{200};
   std::size_t max_message_bytes = 64u << 20;  // ZMQ_MAXMSGSIZE: larger messages drop the peer's connection
   // Log lines ("worker w1 joined (4 slots)"); empty: standard error.

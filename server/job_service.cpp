@@ -139,6 +139,8 @@ struct Job {
   int passes_reported = 0;
   nlohmann::json history = nlohmann::json::array();
   std::vector<JobEvent> events;
+  Clock::time_point last_event{};  // when events.back() was made
+  bool progress_held = false;      // a "progress" event was held back (emit)
   std::string stopped_by;
   int preview_units = -1;
   // Disk (disk_budget.h): what the job may write at most (reserved while it
@@ -221,6 +223,11 @@ struct Job {
 namespace {
 
 const char* kAllocationFile = "allocation.json";
+// A tile is written at most this often while it merges (tile_merger.h): tiny
+// units merge thousands of times a second.  A crash loses at most this much
+// merging (those units are handed out again), never a merged image: a job's
+// tiles are all written before it is done.
+constexpr std::chrono::milliseconds kTilePersistInterval{1000};
 const char* kReportFile = "report.json";
 
 // Writes `text` to `path` atomically (image/atomic_file.h): readers see the
@@ -384,6 +391,10 @@ struct JobService::Impl {
   Job& add_job(JobRecord record, api::RenderRequest request);
   void set_state(Job& job, const std::string& state, const std::string& failure = "");
   void emit(Job& job, const std::string& type);
+  // The "progress" events emit held back, once their interval has passed.
+  void flush_held_progress(Clock::time_point now);
+  // Writes the merged tiles whose persistence interval has passed.
+  void flush_due_tiles(Clock::time_point now);
   nlohmann::json status_of(const Job& job) const;
   // A stopped job's final image, to be written outside the lock, then
   // complete_finish (under it) makes the job done.
@@ -469,7 +480,8 @@ Job& JobService::Impl::add_job(JobRecord record, api::RenderRequest request) {
   job->disk_estimate = estimated_job_bytes(request, job->plan);
   // A finished job without its directory has expired (or lost it): it is not made again.
   job->expired = record.expired || (is_terminal(record.state) && !fs::exists(job->dir));
-  job->merger = std::make_unique<TileMerger>(job->plan, job->dir, 64u << 20, !job->expired);
+  job->merger = std::make_unique<TileMerger>(job->plan, job->dir, std::size_t{64} << 20, !job->expired,
+                                            kTilePersistInterval);
   job->passes_reported = job->merger->complete_passes();
   read_report(*job);
   if (job->plan.adaptive) job->allocation = read_allocation(job->dir / kAllocationFile, job->plan);
@@ -502,14 +514,49 @@ void JobService::Impl::set_state(Job& job, const std::string& state, const std::
   if (state_observer) state_observer(job.record.id, state);
 }
 
+// A status document is the size of the job's history and of its list of
+// workers (a thousand on a big farm), and merged units can come in thousands
+// a second: "progress" events are taken at most every kProgressEventInterval
+// per job.  One held back meanwhile is taken by the next event of the job, or
+// by flush_held_progress (the broker's timeout checks, every 250 ms), so a
+// stream never lags the job by much more than that.  Other events are never
+// held.  The events kept per job are bounded too (kMaxEvents), as a client
+// that reconnects needs only the recent ones.
+constexpr auto kProgressEventInterval = std::chrono::milliseconds(100);
+constexpr std::size_t kMaxEvents = 256;
+
 void JobService::Impl::emit(Job& job, const std::string& type) {
+  const Clock::time_point now = Clock::now();
+  if (type == "progress" && !job.events.empty() && job.events.back().type == "progress" &&
+      now - job.last_event < kProgressEventInterval) {
+    job.progress_held = true;
+    return;
+  }
+  job.progress_held = false;
+  job.last_event = now;
   JobEvent e;
   e.sequence = job.events.empty() ? 1 : job.events.back().sequence + 1;
   e.type = type;
   e.data = status_of(job);
   job.events.push_back(std::move(e));
-  if (job.events.size() > 1000) job.events.erase(job.events.begin(), job.events.begin() + 500);
+  if (job.events.size() > kMaxEvents) job.events.erase(job.events.begin(), job.events.begin() + kMaxEvents / 2);
   changed.notify_all();
+}
+
+void JobService::Impl::flush_due_tiles(Clock::time_point now) {
+  for (const auto& [id, job] : jobs) {
+    if (!job->active() || job->merger->dirty_tiles() == 0) continue;
+    try {
+      job->merger->flush_due(now);
+    } catch (const StorageError& e) {
+      fail_job(*job, e.what());
+    }
+  }
+}
+
+void JobService::Impl::flush_held_progress(Clock::time_point now) {
+  for (const auto& [id, job] : jobs)
+    if (job->progress_held && job->active() && now - job->last_event >= kProgressEventInterval) emit(*job, "progress");
 }
 
 // --- HTTP side ------------------------------------------------------------
@@ -1129,6 +1176,14 @@ std::optional<JobService::Impl::PendingFinish> JobService::Impl::finish_if_compl
   }
   if (stop.empty() && job.merger->complete()) stop = "samples";
   if (stop.empty()) return std::nullopt;
+  // Every merged unit on disk before the job can be done (a restart
+  // rebuilds a missing final image from the tiles).
+  try {
+    job.merger->flush();
+  } catch (const StorageError& e) {
+    fail_job(job, e.what());
+    return std::nullopt;
+  }
   drop_attempts_of(job);
   job.merger->drop_waiting();
   job.finishing = true;
@@ -1318,6 +1373,8 @@ void JobService::check_timeouts(Clock::time_point now) {
     impl_->last_expiry = now;
     impl_->expire(unix_now());
   }
+  impl_->flush_held_progress(Clock::now());
+  impl_->flush_due_tiles(Clock::now());
 }
 
 // --- Timelapse support ------------------------------------------------------

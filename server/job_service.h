@@ -13,8 +13,10 @@
 // only if it is exactly what its unit asked for (unit_result_check.h), and
 // into its tile only in canonical
 // (pass, batch) order; early results wait in memory.  Merged tiles are
-// written atomically to the data directory, so a restarted server resumes
-// from its merged passes and the final image is bit-identical to
+// written atomically to the data directory (each at most once a second while
+// it merges, and all of them before a job is done), so a restarted server
+// resumes from its merged passes (and hands out again what it merged after
+// the last write) and the final image is bit-identical to
 // `skyfarm-worker render`.
 //
 // Disk (ServiceLimits::max_disk_bytes, retention_hours; disk_budget.h): a job

@@ -1,5 +1,6 @@
 #include "server/tile_merger.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -26,8 +27,9 @@ FilmTile empty_tile(const RenderPlan& plan, int t) {
 }  // namespace
 
 TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes,
-                       bool create_dir)
-    : plan_(plan), dir_(std::move(dir)), budget_(memory_budget_bytes) {
+                       bool create_dir, std::chrono::milliseconds persist_interval)
+    : plan_(plan), dir_(std::move(dir)), budget_(memory_budget_bytes),
+      persist_interval_(std::max(persist_interval, std::chrono::milliseconds(0))) {
   std::error_code ec;
   if (create_dir) std::filesystem::create_directories(dir_, ec);
   if (ec) throw StorageError("cannot create " + dir_.string() + ": " + ec.message());
@@ -36,7 +38,36 @@ TileMerger::TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::s
   lru_pos_.resize(static_cast<std::size_t>(plan_.tile_count()));
   next_index_.assign(static_cast<std::size_t>(plan_.tile_count()), 0);
   waiting_.resize(static_cast<std::size_t>(plan_.tile_count()));
+  persisted_at_.resize(static_cast<std::size_t>(plan_.tile_count()));
+  is_dirty_.assign(static_cast<std::size_t>(plan_.tile_count()), 0);
   load();
+}
+
+TileMerger::~TileMerger() {
+  try {
+    flush();
+  } catch (const std::exception&) {
+    // What is not on disk is rendered again after a restart.
+  }
+}
+
+void TileMerger::mark_dirty(int t) {
+  if (is_dirty_[static_cast<std::size_t>(t)]) return;
+  is_dirty_[static_cast<std::size_t>(t)] = 1;
+  dirty_.push_back(t);
+}
+
+void TileMerger::flush() {
+  while (!dirty_.empty()) {
+    const int t = dirty_.back();
+    persist(t, tile(t));
+  }
+}
+
+void TileMerger::flush_due(std::chrono::steady_clock::time_point now) {
+  const std::vector<int> dirty = dirty_;
+  for (const int t : dirty)
+    if (now - persisted_at_[static_cast<std::size_t>(t)] >= persist_interval_) persist(t, tile(t));
 }
 
 bool TileMerger::merged(const WorkUnit& u) const {
@@ -75,7 +106,8 @@ void TileMerger::merge_ready(int tile_index) {
     ++next_index_[t];
     ++merged_units_;
   }
-  persist(tile_index, target);
+  mark_dirty(tile_index);
+  if (std::chrono::steady_clock::now() - persisted_at_[t] >= persist_interval_) persist(tile_index, target);
 }
 
 void TileMerger::set_pass_limit(int passes) {
@@ -103,6 +135,8 @@ void TileMerger::remove_files() {
   lru_.clear();
   cached_bytes_ = 0;
   bytes_on_disk_ = 0;
+  dirty_.clear();  // merged but unwritten tiles are dropped with the rest
+  std::fill(is_dirty_.begin(), is_dirty_.end(), 0);
   files_removed_ = true;
   pass_limit_ = 0;  // nothing merges any more
 }
@@ -145,7 +179,8 @@ std::optional<double> TileMerger::estimated_relative_rms(const std::vector<std::
 // FilmTile's own serialisation (which carries a CRC).
 std::filesystem::path TileMerger::tile_path(int t) const { return dir_ / ("tile_" + std::to_string(t) + ".bin"); }
 
-void TileMerger::persist(int t, const FilmTile& film) {
+void TileMerger::persist(int t, const FilmTile& film) const {
+  if (files_removed_) return;  // a reclaimed job's tiles are never written again
   const auto bytes = film.serialize();
   const std::uint32_t header[2] = {kVersion, static_cast<std::uint32_t>(next_index_[static_cast<std::size_t>(t)])};
   try {
@@ -163,6 +198,11 @@ void TileMerger::persist(int t, const FilmTile& film) {
   auto& known = file_bytes_[static_cast<std::size_t>(t)];
   bytes_on_disk_ += size - known;
   known = size;
+  persisted_at_[static_cast<std::size_t>(t)] = std::chrono::steady_clock::now();
+  if (is_dirty_[static_cast<std::size_t>(t)]) {
+    is_dirty_[static_cast<std::size_t>(t)] = 0;
+    dirty_.erase(std::prev(std::find(dirty_.rbegin(), dirty_.rend(), t).base()));  // flush() takes the last
+  }
 }
 
 // The tile file, validated against the plan; nullopt when absent or damaged
@@ -222,9 +262,17 @@ FilmTile& TileMerger::tile(int t) const {
   cached_bytes_ += bytes;
   lru_.push_front(t);
   lru_pos_[static_cast<std::size_t>(t)] = lru_.begin();
-  // Evict the least recently used tiles (already on disk) beyond the budget.
+  // Evict the least recently used tiles beyond the budget, written first if
+  // they have merges not on disk yet (one that cannot be written stays).
   while (cached_bytes_ > budget_ && lru_.size() > 1) {
     const int victim = lru_.back();
+    if (is_dirty_[static_cast<std::size_t>(victim)]) {
+      try {
+        persist(victim, *cache_[static_cast<std::size_t>(victim)]);
+      } catch (const StorageError&) {
+        break;
+      }
+    }
     lru_.pop_back();
     auto& v = cache_[static_cast<std::size_t>(victim)];
     cached_bytes_ -= static_cast<std::size_t>(v->width()) * static_cast<std::size_t>(v->height()) *

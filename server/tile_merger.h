@@ -6,15 +6,25 @@
 // tile's sums are bit-identical to a local render of the tile however many
 // workers ran it and in whatever order the results came back.  A result that
 // arrives early waits in memory until its predecessors are merged.  After
-// each advance the tile (its sums and how many units it holds) is written
+// an advance the tile (its sums and how many units it holds) is written
 // atomically to <dir>/tile_<t>.bin; a restarted server reloads these files
 // and resumes after the last merged unit of each tile.
+//
+// Persistence interval: with `persist_interval` 0 every advance is written
+// at once.  Above 0 a tile is written at most once per interval (tiny units
+// merge thousands of times a second into few tiles, and each write is a file
+// created and renamed); flush_due() writes the tiles whose interval has
+// passed, flush() all of them, and so does the destructor.  Crash safety
+// does not depend on it: a file records exactly the units it holds, so units
+// merged after its last write are simply not merged after a restart, and the
+// job service hands them out again (the same bytes, deterministically).
 //
 // Memory: only the most recently used tiles stay in memory, up to
 // `memory_budget_bytes` (the others are on disk already and are read back
 // when their next unit arrives), so a 4096x2048 job does not need its whole
 // film in the server's memory.
 #pragma once
+#include <chrono>
 #include <filesystem>
 #include <list>
 #include <map>
@@ -36,14 +46,24 @@ class TileMerger {
   // directory expired) and reloads the tiles found there.  Throws
   // StorageError when the directory cannot be created.
   TileMerger(const RenderPlan& plan, std::filesystem::path dir, std::size_t memory_budget_bytes = 64u << 20,
-             bool create_dir = true);
+             bool create_dir = true,
+             std::chrono::milliseconds persist_interval = std::chrono::milliseconds(0));
+  ~TileMerger();  // flush(), errors ignored
+  TileMerger(const TileMerger&) = delete;
+  TileMerger& operator=(const TileMerger&) = delete;
 
   // A unit's result.  Returns false (and ignores it) when that unit is already
   // merged or waiting.  Throws FilmTileDecodeError on a tile of the wrong
   // geometry, StorageError when the tile cannot be written.
   bool add(const WorkUnit& unit, FilmTile film);
-  // Merged into its tile (and so on disk).
+  // Merged into its tile (on disk within the persistence interval).
   bool merged(const WorkUnit& unit) const;
+  // Write every tile with merges not yet on disk / those of them written
+  // longer than the interval ago.  Throw StorageError when one cannot be written.
+  void flush();
+  void flush_due(std::chrono::steady_clock::time_point now);
+  // Tiles with merges not yet on disk.
+  std::size_t dirty_tiles() const { return dirty_.size(); }
   // Merged or waiting in memory.
   bool received(const WorkUnit& unit) const;
 
@@ -89,7 +109,8 @@ class TileMerger {
   int index_of(const WorkUnit& u) const { return u.pass * plan_.batches + u.batch; }
   void merge_ready(int tile);
   std::filesystem::path tile_path(int tile) const;
-  void persist(int tile, const FilmTile& film);
+  void persist(int tile, const FilmTile& film) const;
+  void mark_dirty(int tile);
   void load();
   // The tile's sums, from memory or disk; keeps the cache within its budget.
   FilmTile& tile(int t) const;
@@ -107,9 +128,13 @@ class TileMerger {
   std::vector<std::map<int, FilmTile>> waiting_;  // per tile: early results by index
   std::int64_t merged_units_ = 0;
   int pass_limit_ = 1 << 30;
-  std::vector<std::int64_t> file_bytes_;  // per tile: its file's size (0: none)
-  std::int64_t bytes_on_disk_ = 0;
+  mutable std::vector<std::int64_t> file_bytes_;  // per tile: its file's size (0: none)
+  mutable std::int64_t bytes_on_disk_ = 0;
   bool files_removed_ = false;
+  std::chrono::steady_clock::duration persist_interval_{};
+  mutable std::vector<std::chrono::steady_clock::time_point> persisted_at_;  // per tile: last write
+  mutable std::vector<int> dirty_;                                          // tiles not written since a merge
+  mutable std::vector<char> is_dirty_;
 };
 
 }  // namespace skyfarm::server

@@ -397,6 +397,10 @@ void FarmWorker::Impl::send_ready(zmq::socket_t& socket) {
   ready.slots = slots;
   ready.capabilities = {{"spectral", true}, {"methods", {"path"}}, {"probe", api::kProbeUnitsVersion}};
   ready.heartbeat_ms = static_cast<int>(options.heartbeat_interval.count());
+  // Units queue in the render pool anyway: with the default slots the server
+  // may send a few more when units are short (api/wire.h "prefetch"); slots
+  // set by hand (--slots) are the most it ever holds.
+  if (options.slots <= 0) ready.prefetch = std::min(api::kMaxSlots, 8 * slots);
   if (!options.token.empty()) ready.token = options.token;
   ++counters.sessions;
   send(socket, ready);

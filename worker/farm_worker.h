@@ -61,7 +61,7 @@ namespace skyfarm {
 struct FarmWorkerOptions {
   std::string endpoint = "tcp://127.0.0.1:5555";
   int threads = 0;     // render threads; 0 = all hardware threads
-  int slots = 0;       // units held at once (credit); 0 = threads + 1
+  int slots = 0;       // units held at once (credit); 0 = threads + 1, plus up to 8 x that queued for short units (READY prefetch)
   std::string token;   // sent inside READY for older servers; no longer a credential (the broker ignores it)
   // CURVE (api/curve_keys.h): the server's public key and this worker's key
   // pair, Z85; server_key empty: the NULL mechanism (tests of the protocol only).

@@ -27,6 +27,9 @@ TEST(WireTest, EveryMessageRoundTrips) {
   ready.token.reset();
   ready.heartbeat_ms = 0;
   expect_round_trip(ready);
+  ready.prefetch = 16;  // optional: absent reads as 0
+  expect_round_trip(ready);
+  EXPECT_EQ(encode(ReadyMsg{}).at(1).find("prefetch"), std::string::npos);
   expect_round_trip(HeartbeatMsg{});
   expect_round_trip(HeartbeatMsg{2500, true});
   expect_round_trip(UnitMsg{sample_ref(), R"({"camera":{"width":16}})"});
@@ -124,6 +127,7 @@ TEST(WireTest, MalformedMessagesAreRejected) {
       {"READY", "{\"id\": \"" + std::string(kMaxIdBytes + 1, 'w') + "\", \"cores\": 1, \"slots\": 1, \"version\": 1}"},
       {"HEARTBEAT", R"({"draining": "yes"})"},
       {"HEARTBEAT", R"({"heartbeat_ms": -5})"},
+      {"READY", R"({"id": "w", "cores": 1, "slots": 1, "version": 3, "prefetch": -1})"},
       {"UNIT", "{" + unit + "}"},                                                    // no request
       {"UNIT", R"({"job": "j", "tile": -1, "batch": 0, "pass": 0, "attempt": 1, "request": "{}"})"},
       {"UNIT", R"({"job": "j", "tile": 0, "batch": 0, "pass": 0, "attempt": -1, "request": "{}"})"},

@@ -151,6 +151,39 @@ TEST_F(BrokerTest, CreditLimitsUnitsToTheWorkersSlots) {
   });
 }
 
+// A worker announcing "prefetch" gets no more than its slots until its
+// results say how long units take; short ones (1 ms against the 100 ms
+// pipeline target) then earn it slots + prefetch, and never more.
+TEST_F(BrokerTest, PrefetchGivesShortUnitsCreditUpToSlotsPlusPrefetch) {
+  start();
+  for (int i = 0; i < 40; ++i) backend_.add_unit("j", i, 0, 0, "{}");
+  auto p = peer();
+  api::ReadyMsg ready = RawPeer::ready("w1", 2);
+  ready.prefetch = 6;
+  p->send(ready);
+  ASSERT_TRUE(p->receive_a<api::HeartbeatMsg>().has_value());
+  std::vector<api::UnitMsg> held;
+  for (int i = 0; i < 2; ++i) {
+    auto u = p->receive_a<api::UnitMsg>();
+    ASSERT_TRUE(u);
+    held.push_back(*u);
+  }
+  EXPECT_TRUE(no_unit_for(*p, 200ms)) << "beyond the slots before any result";
+  p->send(api::ResultMsg{held[0].unit, 1, 0.001, "tile"});
+  held.erase(held.begin());
+  // Now 8 units may be out: 7 more arrive, then nothing.
+  for (int i = 0; i < 7; ++i) {
+    auto u = p->receive_a<api::UnitMsg>();
+    ASSERT_TRUE(u) << i;
+    held.push_back(*u);
+  }
+  EXPECT_TRUE(no_unit_for(*p, 200ms)) << "beyond slots + prefetch";
+  backend_.with_lock([&](auto& b) {
+    EXPECT_EQ(b.max_held["w1"], 8);
+    return 0;
+  });
+}
+
 TEST_F(BrokerTest, SlotsAreFilledAndFailuresFreeThem) {
   start();
   for (int i = 0; i < 4; ++i) backend_.add_unit("j", i, 0, 0, "{}");

@@ -212,6 +212,27 @@ TEST(JobService, UnitFailingOnThreeWorkersFailsTheJobWithTheMessage) {
   EXPECT_FALSE(service.next_unit("w9").has_value());
 }
 
+// Progress events are taken at most every 100 ms per job (a status document
+// per merged unit bounded a big farm); one held back is emitted by the
+// broker's timeout check, so the last event always shows the last merge.
+TEST(JobService, AHeldBackProgressEventIsEmittedByTheTimeoutCheck) {
+  JobService service(fresh_dir("events"));
+  const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;
+  std::vector<std::pair<UnitAssignment, std::vector<std::uint8_t>>> results;
+  for (int i = 0; i < 4; ++i) {
+    const auto a = service.next_unit("w");
+    ASSERT_TRUE(a);
+    results.emplace_back(*a, render_assignment(*a));
+  }
+  for (const auto& [a, bytes] : results) service.unit_done("w", a.key, a.attempt, bytes, 1);
+  std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  service.check_timeouts(Clock::now());
+  const auto events = service.events_after(id, 0, std::chrono::milliseconds(0));
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.back().type, "progress");
+  EXPECT_EQ(events.back().data["progress"]["units_done"], 4);
+}
+
 TEST(JobService, CancelStopsDispatchAndListsAttempts) {
   JobService service(fresh_dir("cancel"));
   const auto id = service.submit(api::parse_render_request(kRequest), std::nullopt).id;

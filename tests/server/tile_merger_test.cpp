@@ -74,6 +74,50 @@ TEST(TileMerger, PassLimitMergesExactlyThatManyPasses) {
   std::filesystem::remove_all(dir);
 }
 
+// With a persistence interval, merges after a tile's last write are not on
+// disk; a crash (the merger never destroyed) then loses exactly those, a
+// restarted merger resumes from what the files record, and the units merged
+// again give the same sums as an uninterrupted merge.
+TEST(TileMerger, MergesNotYetWrittenAreMergedAgainAfterACrash) {
+  const RenderPlan plan = make_render_plan(64, 32, 360.0, 830.0, 2, 48, 1);  // 2 tiles x 2 batches x 3 passes
+  ASSERT_EQ(plan.unit_count(), 12);
+  auto result = [&](const WorkUnit& u) {
+    int x0 = 0, y0 = 0, w = 0, h = 0;
+    plan.tile_rect(u.tile, &x0, &y0, &w, &h);
+    FilmTile film(x0, y0, w, h, plan.batches);
+    const double v = 1.0 + u.pass * 0.25 + u.batch * 0.125;  // distinct per unit: order matters
+    film.set_sums(x0, y0, u.batch, PixelBatchSums{16.0, v, v, v, v * v, v, v, v, v});
+    return film;
+  };
+  const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_merger_crash_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  const std::vector<WorkUnit> units = plan.units();
+  // The merger that "crashes": each tile's first merge is written, the rest wait for the hour.
+  auto* crashed = new TileMerger(plan, dir / "a", 64u << 20, std::chrono::hours(1));
+  for (const auto& u : units) ASSERT_TRUE(crashed->add(u, result(u)));
+  EXPECT_TRUE(crashed->complete());
+  EXPECT_EQ(crashed->dirty_tiles(), 2u);
+  // Never destroyed (a destructor would flush): the crash.  Deliberately leaked.
+  TileMerger restarted(plan, dir / "a");
+  EXPECT_EQ(restarted.merged_units(), 2) << "the first unit of each tile, as written";
+  int again = 0;
+  for (const auto& u : units)
+    if (!restarted.merged(u)) again += restarted.add(u, result(u)) ? 1 : 0;
+  EXPECT_EQ(again, 10);
+  EXPECT_TRUE(restarted.complete());
+
+  TileMerger direct(plan, dir / "b");
+  for (const auto& u : units) ASSERT_TRUE(direct.add(u, result(u)));
+  for (int t = 0; t < plan.tile_count(); ++t)
+    EXPECT_EQ(restarted.sums_of(t).serialize(), direct.sums_of(t).serialize()) << "tile " << t;
+
+  // flush() writes everything: a reload sees every unit.
+  crashed->flush();
+  EXPECT_EQ(crashed->dirty_tiles(), 0u);
+  EXPECT_TRUE(TileMerger(plan, dir / "a").complete());
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace skyfarm::server
 
