@@ -93,7 +93,7 @@ TEST(TileMerger, MergesNotYetWrittenAreMergedAgainAfterACrash) {
   std::filesystem::remove_all(dir);
   const std::vector<WorkUnit> units = plan.units();
   // The merger that "crashes": each tile's first merge is written, the rest wait for the hour.
-  auto* crashed = new TileMerger(plan, dir / "a", 64u << 20, std::chrono::hours(1));
+  auto* crashed = new TileMerger(plan, dir / "a", 64u << 20, true, std::chrono::hours(1));
   for (const auto& u : units) ASSERT_TRUE(crashed->add(u, result(u)));
   EXPECT_TRUE(crashed->complete());
   EXPECT_EQ(crashed->dirty_tiles(), 2u);
@@ -115,6 +115,33 @@ TEST(TileMerger, MergesNotYetWrittenAreMergedAgainAfterACrash) {
   crashed->flush();
   EXPECT_EQ(crashed->dirty_tiles(), 0u);
   EXPECT_TRUE(TileMerger(plan, dir / "a").complete());
+  std::filesystem::remove_all(dir);
+}
+
+// A reclaimed job's tiles stay gone: merges not yet written when its files
+// are removed are dropped, not written by a later flush or the destructor.
+TEST(TileMerger, RemovedFilesAreNotWrittenAgainByPendingMerges) {
+  const RenderPlan plan = make_render_plan(64, 32, 360.0, 830.0, 2, 48, 1);  // 2 tiles x 2 batches x 3 passes
+  const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_merger_removed_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  {
+    TileMerger merger(plan, dir, 64u << 20, true, std::chrono::hours(1));
+    for (const auto& u : plan.units()) {
+      int x0 = 0, y0 = 0, w = 0, h = 0;
+      plan.tile_rect(u.tile, &x0, &y0, &w, &h);
+      FilmTile film(x0, y0, w, h, plan.batches);
+      film.set_sums(x0, y0, u.batch, PixelBatchSums{16.0, 1, 1, 1, 1, 1, 1, 1, 1});
+      ASSERT_TRUE(merger.add(u, std::move(film)));
+    }
+    ASSERT_GT(merger.dirty_tiles(), 0u);
+    merger.remove_files();
+    EXPECT_EQ(merger.dirty_tiles(), 0u);
+    merger.flush();
+    EXPECT_EQ(merger.bytes_on_disk(), 0);
+  }
+  int tiles = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) tiles += e.path().extension() == ".bin";
+  EXPECT_EQ(tiles, 0);
   std::filesystem::remove_all(dir);
 }
 
