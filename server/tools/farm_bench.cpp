@@ -39,7 +39,7 @@ using skyfarm::server::FarmSimResult;
 constexpr const char* kUsage =
     "usage: skyfarm-farm-bench [--workers N] [--units N] [--jobs N] [--slots N] [--prefetch N] [--unit-ms MS]\n"
     "                          [--width W] [--height H] [--batches B] [--runs R] [--timeout S]\n"
-    "                          [--data-dir DIR] [--json] [--log]\n";
+    "                          [--data-dir DIR] [--no-curve] [--json] [--log]\n";
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -125,6 +125,7 @@ int main(int argc, char** argv) {
       else if (a == "--runs") runs = static_cast<int>(integer(1, 100));
       else if (a == "--timeout") o.timeout_s = real();
       else if (a == "--data-dir") o.data_dir = value();
+      else if (a == "--no-curve") o.curve = false;
       else if (a == "--json") json = true;
       else if (a == "--log") o.log = [](std::string_view line) { std::cerr << line << "\n"; };
       else if (a == "--help" || a == "-h") {

@@ -13,6 +13,7 @@
 
 #include <zmq_addon.hpp>
 
+#include "api/curve_keys.h"
 #include "api/render_request.h"
 #include "api/render_setup.h"
 #include "api/wire.h"
@@ -102,7 +103,7 @@ class SimWorkers {
     workers_.reserve(static_cast<std::size_t>(options.workers));
     for (int i = 0; i < options.workers; ++i) {
       SimWorker w{zmq::socket_t(ctx_, zmq::socket_type::dealer), "sim-" + std::to_string(i), false, {}, {}};
-      configure_sim_worker_socket(w.socket);
+      configure_sim_worker_socket(w.socket, options.curve);
       w.socket.connect(endpoint);
       workers_.push_back(std::move(w));
     }
@@ -284,9 +285,20 @@ struct TempDir {
 
 }  // namespace
 
-void configure_sim_worker_socket(zmq::socket_t& socket) {
+namespace {
+// Not a credential anywhere: the broker of the simulation lets in its keys only.
+constexpr const char* kSimSecret = "skyfarm-farm-bench simulation secret";
+}  // namespace
+
+void configure_sim_worker_socket(zmq::socket_t& socket, bool curve) {
   socket.set(zmq::sockopt::linger, 0);
   socket.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64) << 20);
+  if (!curve) return;
+  static const api::CurveKeyPair worker = api::derive_worker_keys(kSimSecret);
+  static const api::CurveKeyPair server = api::derive_server_keys(kSimSecret);
+  socket.set(zmq::sockopt::curve_serverkey, server.public_key);
+  socket.set(zmq::sockopt::curve_publickey, worker.public_key);
+  socket.set(zmq::sockopt::curve_secretkey, worker.secret_key);
 }
 
 FarmSimResult run_farm_sim(const FarmSimOptions& o) {
@@ -338,6 +350,10 @@ FarmSimResult run_farm_sim(const FarmSimOptions& o) {
   BrokerOptions broker_options;
   broker_options.endpoint = "tcp://127.0.0.1:*";
   broker_options.log = o.log ? o.log : [](std::string_view) {};
+  if (o.curve) {
+    broker_options.curve_secret_key = api::derive_server_keys(kSimSecret).secret_key;
+    broker_options.auth.allowed_keys = {api::derive_worker_keys(kSimSecret).public_key};
+  }
   Broker broker(router, broker_options);
   broker.start();
 

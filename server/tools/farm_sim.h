@@ -54,6 +54,9 @@ struct FarmSimOptions {
   int width = 1, height = 1, batches = 64;
   std::filesystem::path data_dir;
   double timeout_s = 600.0;
+  // CurveZMQ between the broker and the simulated workers, as skyfarm-server
+  // runs it (keys derived from a fixed secret); false: the NULL mechanism.
+  bool curve = true;
   // Broker log lines; empty: dropped.
   std::function<void(std::string_view)> log;
 };
@@ -78,8 +81,9 @@ struct FarmSimResult {
 };
 
 // Sets up one simulated worker's DEALER socket before it connects (linger,
-// message size; authentication options go here).
-void configure_sim_worker_socket(zmq::socket_t& socket);
+// message size, and with `curve` the CURVE client keys of the simulation's
+// shared secret).
+void configure_sim_worker_socket(zmq::socket_t& socket, bool curve);
 
 // Runs the simulation to completion (or timeout_s); throws std::runtime_error
 // when the farm cannot be set up (bad options, no data directory).
