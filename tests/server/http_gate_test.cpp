@@ -156,6 +156,21 @@ class HttpGateTest : public testing::HttpFixture {
 
 const std::string kHealthz = "GET /healthz HTTP/1.1\r\nHost: t\r\n\r\n";
 
+// Sends a POST head ending with `body_header` (its body framing and the
+// head's end, e.g. "Content-Length: 100\r\n\r\n"), then trickles a 100-byte
+// body; asserts the connection was cut with a 408 before the body was sent.
+void expect_slow_body_cut(int port, const std::string& body_header) {
+  const int fd = connect_loopback(port);
+  ASSERT_GE(fd, 0);
+  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n" +
+                               body_header));
+  const Trickle t = trickle(fd, std::string(100, ' '));
+  ::close(fd);
+  EXPECT_TRUE(t.closed) << "still open after " << t.sent << " body bytes";
+  EXPECT_LT(t.sent, kSlowBytesMax);
+  EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
+}
+
 TEST_F(HttpGateTest, SlowHeadIsCutAtTheHeaderDeadline) {
   start(1s, 30s);
   const int fd = connect_loopback(port_);
@@ -172,29 +187,13 @@ TEST_F(HttpGateTest, SlowHeadIsCutAtTheHeaderDeadline) {
 // A Content-Length body small enough to wait in the gate.
 TEST_F(HttpGateTest, SlowBodyIsCutAtTheBodyDeadline) {
   start(30s, 1s);
-  const int fd = connect_loopback(port_);
-  ASSERT_GE(fd, 0);
-  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
-                           "Content-Length: 100\r\n\r\n"));
-  const Trickle t = trickle(fd, std::string(100, ' '));
-  ::close(fd);
-  EXPECT_TRUE(t.closed) << "still open after " << t.sent << " body bytes";
-  EXPECT_LT(t.sent, kSlowBytesMax);
-  EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
+  expect_slow_body_cut(port_, "Content-Length: 100\r\n\r\n");
 }
 
 // A chunked body waits in the gate too.
 TEST_F(HttpGateTest, SlowChunkedBodyIsCutAtTheBodyDeadline) {
   start(30s, 1s);
-  const int fd = connect_loopback(port_);
-  ASSERT_GE(fd, 0);
-  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
-                           "Transfer-Encoding: chunked\r\n\r\n64\r\n"));
-  const Trickle t = trickle(fd, std::string(100, ' '));
-  ::close(fd);
-  EXPECT_TRUE(t.closed) << "still open after " << t.sent << " body bytes";
-  EXPECT_LT(t.sent, kSlowBytesMax);
-  EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
+  expect_slow_body_cut(port_, "Transfer-Encoding: chunked\r\n\r\n64\r\n");
   // The thread went back to the pool.
   auto r = client().Get("/healthz");
   ASSERT_TRUE(r);
@@ -206,15 +205,7 @@ TEST_F(HttpGateTest, SlowChunkedBodyIsCutAtTheBodyDeadline) {
 TEST_F(HttpGateTest, SlowLargeBodyIsCutOnThePoolThread) {
   gate_.max_buffered_body = 16;
   start(30s, 1s);
-  const int fd = connect_loopback(port_);
-  ASSERT_GE(fd, 0);
-  ASSERT_TRUE(send_all(fd, "POST /v1/renders HTTP/1.1\r\nHost: t\r\nContent-Type: application/json\r\n"
-                           "Content-Length: 100\r\n\r\n"));
-  const Trickle t = trickle(fd, std::string(100, ' '));
-  ::close(fd);
-  EXPECT_TRUE(t.closed) << "still open after " << t.sent << " body bytes";
-  EXPECT_LT(t.sent, kSlowBytesMax);
-  EXPECT_TRUE(t.received.starts_with("HTTP/1.1 408 ")) << t.received;
+  expect_slow_body_cut(port_, "Content-Length: 100\r\n\r\n");
   for (int i = 0; i < 300 && server_->open_connections() > 0; ++i) std::this_thread::sleep_for(10ms);
   EXPECT_EQ(server_->open_connections(), 0);
   EXPECT_NE(metrics().find("skyfarm_http_request_timeouts_total{part=\"body\"} 1\n"), std::string::npos);
