@@ -13,7 +13,7 @@
 // The probe's cut into units is probe_plan(): ProbePlan::make(directions x
 // wavelengths, samples, max_units) with max_units = 4096, fewer for a long
 // request (every unit carries the request's text: max_units x text stays
-// under 256 MiB, and never below 64 units).  The farm (server/probe_service.h,
+// under 256 MiB, and never below 64 units).  The farm (server/probes/probe_service.h,
 // the worker) and the CLI all use it, which is what makes their answers equal.
 #pragma once
 #include <memory>

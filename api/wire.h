@@ -1,13 +1,13 @@
 // The server <-> worker protocol of the render farm, as ZeroMQ multipart
 // frames.  The server binds a ROUTER, every worker connects a DEALER; the
 // connection is CurveZMQ (encrypted, each worker authenticated by its public
-// key in the server's ZAP handler: api/curve_keys.h, server/broker.h), so
+// key in the server's ZAP handler: api/curve_keys.h, server/broker/broker.h), so
 // everything below rides inside CURVE.  A DEALER sends and receives
 //
 //     [command] [header JSON object] [payload]        (payload: RESULT only)
 //
 // and the ROUTER sees the peer's routing identity as an extra first frame
-// (server/broker.cpp strips and adds it; this file never sees it).  The
+// (server/broker/broker.cpp strips and adds it; this file never sees it).  The
 // command frame is the ASCII name below; the header is a JSON object (an
 // empty header frame, or none at all, reads as {} for commands without
 // required fields); results travel as binary FilmTile::serialize() bytes,
@@ -40,7 +40,7 @@
 // ones it renders (absent or 0: none, the server sends at most `slots`).  The
 // server uses them only when units are short: it sizes each worker's credit
 // from the render time its RESULTs report so that the worker holds about the
-// broker's pipeline_target of work (server/broker.h), between `slots` and
+// broker's pipeline_target of work (server/broker/broker.h), between `slots` and
 // `slots + prefetch`, so that tiny units do not leave a worker idle for a
 // round trip after each.  A field older peers ignore: no version change.
 //

@@ -12,15 +12,15 @@
 
 #include "api/curve_keys.h"
 #include "common/render/parallel.h"
-#include "server/broker.h"
-#include "server/http_api.h"
-#include "server/http_gate.h"
-#include "server/job_service.h"
-#include "server/local_workers.h"
-#include "server/probe_router.h"
-#include "server/probe_service.h"
+#include "server/broker/broker.h"
+#include "server/http/http_api.h"
+#include "server/http/http_gate.h"
+#include "server/jobs/job_service.h"
+#include "server/broker/local_workers.h"
+#include "server/probes/probe_router.h"
+#include "server/probes/probe_service.h"
 #include "server/server_options.h"
-#include "server/timelapse_service.h"
+#include "server/timelapse/timelapse_service.h"
 
 namespace {
 

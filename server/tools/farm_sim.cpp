@@ -20,9 +20,9 @@
 #include "common/film/film_tile.h"
 #include "common/render/render_plan.h"
 #include "common/sun/sun.h"
-#include "server/job_service.h"
-#include "server/probe_router.h"
-#include "server/probe_service.h"
+#include "server/jobs/job_service.h"
+#include "server/probes/probe_router.h"
+#include "server/probes/probe_service.h"
 
 namespace skyfarm::server {
 namespace {

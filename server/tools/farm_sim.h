@@ -40,7 +40,7 @@
 
 #include <zmq.hpp>
 
-#include "server/broker.h"
+#include "server/broker/broker.h"
 
 namespace skyfarm::server {
 

@@ -21,8 +21,8 @@
 #include <string>
 #include <vector>
 
-#include "server/http_sky.h"
-#include "server/sky_service.h"
+#include "server/sky/http_sky.h"
+#include "server/sky/sky_service.h"
 
 namespace {
 

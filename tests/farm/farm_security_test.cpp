@@ -11,7 +11,7 @@
 
 #include "api/curve_keys.h"
 #include "tests/farm/farm_process.h"
-#include "tests/server/fake_broker_backend.h"
+#include "tests/server/broker/fake_broker_backend.h"
 
 namespace skyfarm {
 namespace {

@@ -1,6 +1,6 @@
-// A test fixture serving the HTTP API (server/http_api.h) over a fake job
+// A test fixture serving the HTTP API (server/http/http_api.h) over a fake job
 // backend on a free loopback port, behind the connection gate
-// (server/http_gate.h, options in gate_): serve(options) binds and listens,
+// (server/http/http_gate.h, options in gate_): serve(options) binds and listens,
 // client() talks to it, TearDown stops it.
 #pragma once
 #include <gtest/gtest.h>
@@ -10,9 +10,9 @@
 #include <memory>
 #include <thread>
 
-#include "server/http_api.h"
-#include "server/http_gate.h"
-#include "tests/server/fake_backend.h"
+#include "server/http/http_api.h"
+#include "server/http/http_gate.h"
+#include "tests/server/http/fake_backend.h"
 
 namespace skyfarm::server::testing {
 

@@ -1,4 +1,4 @@
-// The web page's files over HTTP (server/http_web.h): served from the binary
+// The web page's files over HTTP (server/http/http_web.h): served from the binary
 // at / and /web/*, with their Content-Type, a strong ETag that If-None-Match
 // turns into 304, Cache-Control no-cache, public even when the API needs a
 // token; unknown files stay 404 problems.  And a static check of the page:
@@ -13,8 +13,8 @@
 #include <string>
 #include <thread>
 
-#include "server/http_api.h"
-#include "tests/server/fake_backend.h"
+#include "server/http/http_api.h"
+#include "tests/server/http/fake_backend.h"
 #include "tests/support/http_fixture.h"
 #include "tests/support/test_files.h"
 
@@ -25,7 +25,7 @@ namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using skyfarm::testing::read_text;
 
-const fs::path kWebDir = fs::path(SKYFARM_SOURCE_DIR) / "server" / "web";
+const fs::path kWebDir = fs::path(SKYFARM_SOURCE_DIR) / "server" / "http" / "web";
 
 class HttpWebTest : public testing::HttpFixture {
  protected:

@@ -17,7 +17,7 @@
 #include <optional>
 #include <string>
 
-#include "server/timelapse_video.h"
+#include "server/timelapse/timelapse_video.h"
 #include "tests/farm/farm_process.h"
 #include "tests/support/webdriver.h"
 

@@ -20,8 +20,8 @@
 #include "api/render_setup.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
-#include "server/broker.h"
-#include "tests/server/fake_broker_backend.h"
+#include "server/broker/broker.h"
+#include "tests/server/broker/fake_broker_backend.h"
 
 extern char** environ;
 

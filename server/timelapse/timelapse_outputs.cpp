@@ -1,0 +1,103 @@
+#include "server/timelapse/timelapse_outputs.h"
+
+#include <cstdio>
+#include <stdexcept>
+
+#include "common/film/image.h"
+#include "common/image/exr_writer.h"
+#include "common/image/png_writer.h"
+#include "server/timelapse/timelapse_contact_sheet.h"
+#include "server/timelapse/timelapse_exposure.h"
+#include "server/timelapse/timelapse_video.h"
+
+namespace skyfarm::server {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A frame's linear RGB and skyfarm:* metadata from its EXR.
+Image load_frame(const fs::path& exr_path) {
+  const ExrFile exr = read_exr(exr_path);
+  const auto r = exr.channels.find("R"), g = exr.channels.find("G"), b = exr.channels.find("B");
+  if (r == exr.channels.end() || g == exr.channels.end() || b == exr.channels.end())
+    throw std::runtime_error(exr_path.string() + " has no R, G, B channels");
+  Image image(exr.width, exr.height);
+  for (int y = 0; y < exr.height; ++y)
+    for (int x = 0; x < exr.width; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(exr.width) + static_cast<std::size_t>(x);
+      image.set_rgb(x, y, Rgb{r->second.values[i], g->second.values[i], b->second.values[i]});
+    }
+  const std::string prefix = kExrMetadataPrefix;
+  for (const auto& [key, value] : exr.string_attributes)
+    if (key.starts_with(prefix)) image.set_metadata(key.substr(prefix.size()), value);
+  for (const auto& [key, value] : exr.number_attributes)
+    if (key.starts_with(prefix)) image.set_metadata(key.substr(prefix.size()), value);
+  return image;
+}
+
+// Every frame's EV100: fixed, or automatic and smoothed in time.
+std::vector<double> frame_exposures(const std::vector<FrameInput>& frames, const OutputSettings& settings,
+                                    const std::atomic<bool>& stop) {
+  if (settings.fixed_ev100) return std::vector<double>(frames.size(), *settings.fixed_ev100);
+  std::vector<double> metered;
+  for (const FrameInput& f : frames) {
+    if (stop) return {};
+    metered.push_back(auto_exposure_ev(load_frame(f.exr)));
+  }
+  return smoothed_exposure(metered, settings.smoothing_frames);
+}
+
+}  // namespace
+
+fs::path frame_png_path(const fs::path& dir, int index) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%05d.png", index);
+  return dir / "frames" / name;
+}
+
+OutputsReport build_timelapse_outputs(const std::vector<FrameInput>& frames, const OutputSettings& settings,
+                                      const fs::path& dir, const std::atomic<bool>& stop) {
+  OutputsReport report;
+  if (frames.empty()) throw std::runtime_error("a timelapse without frames");
+  report.ev100 = frame_exposures(frames, settings, stop);
+  if (stop) {
+    report.stopped = true;
+    return report;
+  }
+  std::error_code ec;
+  fs::create_directories(dir / "frames", ec);
+  if (ec) throw FileWriteError("cannot create " + (dir / "frames").string() + ": " + ec.message());
+  std::optional<ContactSheet> sheet;
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    if (stop) {
+      report.stopped = true;
+      return report;
+    }
+    Image image = load_frame(frames[i].exr);
+    image.set_metadata("timelapse_frame_index", static_cast<double>(i));
+    image.set_metadata("timelapse_frame_time", frames[i].label);
+    PngWriteOptions png;
+    png.exposure_ev = report.ev100[i];
+    write_png(image, frame_png_path(dir, static_cast<int>(i)), png);
+    if (!sheet) sheet.emplace(static_cast<int>(frames.size()), image.width(), image.height());
+    sheet->add(static_cast<int>(i), image, report.ev100[i], frames[i].label);
+  }
+  sheet->write(dir / "contact_sheet.png");
+
+  const FfmpegLookup ffmpeg = find_ffmpeg(settings.ffmpeg);
+  if (!ffmpeg.path) {
+    report.video_reason = ffmpeg.reason;
+    return report;
+  }
+  const VideoResult video = encode_video(*ffmpeg.path, dir / "frames", settings.fps, dir / "video.mp4",
+                                         dir / "ffmpeg.log", settings.ffmpeg_timeout, stop);
+  if (stop && !video.available) {
+    report.stopped = true;
+    return report;
+  }
+  report.video = video.available;
+  report.video_reason = video.reason;
+  return report;
+}
+
+}  // namespace skyfarm::server
