@@ -71,7 +71,7 @@
 #include <string_view>
 #include <thread>
 
-#include "server/jobs/job_service.h"
+#include "server/broker/broker_backend.h"
 #include "server/broker/worker_auth.h"
 
 namespace skyfarm::server {

@@ -60,7 +60,7 @@
 
 #include "server/http/http_events.h"
 #include "server/http/http_metrics.h"
-#include "server/jobs/job_service.h"
+#include "server/http/http_backend.h"
 #include "server/probes/probe_service.h"
 #include "server/sky/sky_service.h"
 

@@ -46,7 +46,7 @@ EventStream::EventStream(HttpBackend& backend, std::string job_id, std::uint64_t
       job_id_(std::move(job_id)),
       last_sent_(after),
       keepalive_(std::max(keepalive, std::chrono::milliseconds(1))),
-      last_write_(Clock::now()) {}
+      last_write_(std::chrono::steady_clock::now()) {}
 
 bool EventStream::provide(httplib::DataSink& sink) noexcept {
   try {
@@ -57,12 +57,12 @@ bool EventStream::provide(httplib::DataSink& sink) noexcept {
     const bool first_call = !polled_once_;
     polled_once_ = true;
     const auto wait = std::min(keepalive_, kPollSlice);
-    const auto start = Clock::now();
+    const auto start = std::chrono::steady_clock::now();
     std::string out = frames_after(wait);
     // A backend that answers "nothing" at once (unknown job) must not make
     // this loop spin: check the job, then wait out the slice.
-    const bool early = out.empty() && Clock::now() - start < wait / 2;
-    const bool keepalive_due = Clock::now() - last_write_ >= keepalive_;
+    const bool early = out.empty() && std::chrono::steady_clock::now() - start < wait / 2;
+    const bool keepalive_due = std::chrono::steady_clock::now() - last_write_ >= keepalive_;
     if (out.empty() && (first_call || keepalive_due || early) && job_over()) {
       out = frames_after(std::chrono::milliseconds(0));  // a terminal event may have just arrived
       finished_ = true;
@@ -96,7 +96,7 @@ std::string EventStream::frames_after(std::chrono::milliseconds wait) {
 
 bool EventStream::write(httplib::DataSink& sink, const std::string& text) {
   if (!sink.is_writable() || !sink.write(text.data(), text.size())) return false;
-  last_write_ = Clock::now();
+  last_write_ = std::chrono::steady_clock::now();
   return true;
 }
 

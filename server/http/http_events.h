@@ -16,7 +16,7 @@
 #include <string_view>
 #include <vector>
 
-#include "server/jobs/job_service.h"
+#include "server/http/http_backend.h"
 
 namespace httplib {
 class DataSink;
@@ -68,7 +68,7 @@ class EventStream {
   const std::string job_id_;
   std::uint64_t last_sent_;
   const std::chrono::milliseconds keepalive_;
-  Clock::time_point last_write_;
+  std::chrono::steady_clock::time_point last_write_;
   bool finished_ = false;
   bool polled_once_ = false;
 };

@@ -17,7 +17,7 @@
 #pragma once
 #include <string>
 
-#include "server/jobs/job_service.h"
+#include "server/http/http_backend.h"
 
 namespace httplib {
 struct Request;

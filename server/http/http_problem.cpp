@@ -5,7 +5,7 @@
 #include <iostream>
 #include <mutex>
 
-#include "server/jobs/job_service.h"
+#include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
 namespace {

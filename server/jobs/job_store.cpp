@@ -2,7 +2,9 @@
 
 #include <sqlite3.h>
 
-#include "server/jobs/job_service.h"
+#include <optional>
+
+#include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
 namespace {
@@ -85,7 +87,7 @@ void JobStore::insert(const JobRecord& job) {
   s.bind(2, job.request);
   s.bind(3, job.request_hash);
   s.bind(4, static_cast<std::int64_t>(job.priority));
-  s.bind(5, job.state);
+  s.bind(5, to_string(job.state));
   s.bind(6, job.created_unix);
   s.bind(7, job.failure);
   s.bind(8, job.idempotency_key);
@@ -93,9 +95,9 @@ void JobStore::insert(const JobRecord& job) {
   s.step();
 }
 
-void JobStore::set_state(const std::string& id, const std::string& state, const std::string& failure) {
+void JobStore::set_state(const std::string& id, JobState state, const std::string& failure) {
   Statement s(db_, "UPDATE jobs SET state = ?, failure = ? WHERE id = ?", path_);
-  s.bind(1, state);
+  s.bind(1, to_string(state));
   s.bind(2, failure);
   s.bind(3, id);
   s.step();
@@ -142,9 +144,15 @@ std::vector<JobRecord> JobStore::load_all() const {
     j.request = s.text(1);
     j.request_hash = s.text(2);
     j.priority = static_cast<int>(s.integer(3));
-    j.state = s.text(4);
+    const std::string state = s.text(4);
     j.created_unix = s.real(5);
     j.failure = s.text(6);
+    if (const std::optional<JobState> known = parse_job_state(state)) {
+      j.state = *known;
+    } else {  // written by a newer server, or damaged: not resumed
+      j.state = JobState::kFailed;
+      j.failure = "the job store holds an unknown state \"" + state + "\" for this job";
+    }
     j.idempotency_key = s.text(7);
     j.sequence = s.integer(8);
     j.finished_unix = s.real(9);

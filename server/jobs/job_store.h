@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "server/jobs/job_state.h"
+
 struct sqlite3;
 
 namespace skyfarm::server {
@@ -19,7 +21,7 @@ struct JobRecord {
   std::string request;      // canonical request text
   std::string request_hash; // hex hash of `request` (result cache key)
   int priority = 50;
-  std::string state;        // queued | running | done | failed | cancelled
+  JobState state = JobState::kQueued;
   double created_unix = 0.0;
   std::string failure;      // message when failed
   std::string idempotency_key;
@@ -36,7 +38,7 @@ class JobStore {
   JobStore& operator=(const JobStore&) = delete;
 
   void insert(const JobRecord& job);
-  void set_state(const std::string& id, const std::string& state, const std::string& failure = "");
+  void set_state(const std::string& id, JobState state, const std::string& failure = "");
   void set_finished(const std::string& id, double finished_unix);
   void set_expired(const std::string& id);
   // Forgets the job (its idempotency key too).

@@ -10,7 +10,7 @@
 #include "common/film/ground_pool.h"
 #include "common/film/mirror_image.h"
 #include "common/image/atomic_file.h"
-#include "server/jobs/job_service.h"
+#include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
 namespace {

@@ -16,7 +16,7 @@
 #pragma once
 #include <cstdint>
 
-#include "server/jobs/job_service.h"
+#include "server/broker/broker_backend.h"
 #include "server/probes/probe_service.h"
 
 namespace skyfarm::server {

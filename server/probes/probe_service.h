@@ -41,7 +41,8 @@
 #include <nlohmann/json.hpp>
 
 #include "api/probe_request.h"
-#include "server/jobs/job_service.h"
+#include "server/broker/broker_backend.h"
+#include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "common/image/atomic_file.h"
-#include "server/jobs/job_service.h"
+#include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
 namespace {
@@ -33,7 +33,7 @@ nlohmann::json record_json(const TimelapseRecord& r) {
           {"request", r.request},
           {"sequence", r.sequence},
           {"created_unix", r.created_unix},
-          {"state", r.state},
+          {"state", to_string(r.state)},
           {"failure", r.failure},
           {"idempotency_key", r.idempotency_key},
           {"render_ids", r.render_ids},
@@ -53,7 +53,10 @@ TimelapseRecord record_from_json(const nlohmann::json& j) {
   r.request = j.at("request");
   r.sequence = field<std::int64_t>(j, "sequence");
   r.created_unix = field<double>(j, "created_unix");
-  r.state = field<std::string>(j, "state");
+  const std::string state = field<std::string>(j, "state");
+  const std::optional<JobState> known = parse_job_state(state);
+  if (!known) throw std::runtime_error("unknown state \"" + state + "\"");
+  r.state = *known;
   r.failure = field<std::string>(j, "failure");
   r.idempotency_key = field<std::string>(j, "idempotency_key");
   r.render_ids = field<std::vector<std::string>>(j, "render_ids");

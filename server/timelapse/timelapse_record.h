@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "server/jobs/job_state.h"
+
 #include <nlohmann/json.hpp>
 
 namespace skyfarm::server {
@@ -24,7 +26,7 @@ struct TimelapseRecord {
   nlohmann::json request;  // api::to_canonical_json of the timelapse request
   std::int64_t sequence = 0;  // creation order (GET /v1/timelapses lists newest first)
   double created_unix = 0.0;
-  std::string state = "queued";  // queued | running | done | failed | cancelled
+  JobState state = JobState::kQueued;  // a timelapse goes through the states of a render job
   std::string failure;           // when failed: which frame and why
   std::string idempotency_key;
   std::vector<std::string> render_ids;

@@ -16,8 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool is_terminal(const std::string& state) { return state == "done" || state == "failed" || state == "cancelled"; }
-
 void log_line(const std::string& text) { std::cerr << "skyfarm-server: " << text << std::endl; }
 
 std::string frame_name(const api::TimelapseRequest& request, int i, const std::string& render_id) {
@@ -71,7 +69,7 @@ TimelapseService::TimelapseService(JobService& jobs, fs::path data_dir, Timelaps
     timelapses_[t->record.id] = std::move(t);
   }
   for (const std::string& p : problems) log_line("timelapse record skipped: " + p);
-  jobs_.set_state_observer([this](const std::string&, const std::string&) { poke(); });
+  jobs_.set_state_observer([this](const std::string&, JobState) { poke(); });
   thread_ = std::thread([this] { run(); });
 }
 
@@ -151,26 +149,26 @@ bool TimelapseService::refresh(Entry& t) {
       changed = true;
       continue;
     }
-    if (s->state == "failed") {
+    if (s->state == JobState::kFailed) {
       fail(t, frame_name(t.request, i, render_id) + " failed: " + s->failure);
       return false;
     }
-    if (s->state == "cancelled") {
+    if (s->state == JobState::kCancelled) {
       fail(t, frame_name(t.request, i, render_id) + " was cancelled");
       return false;
     }
-    if (s->state == "done") {
+    if (s->state == JobState::kDone) {
       ++done;
     } else {
       ++active;
-      started = started || s->state == "running";
+      started = started || s->state == JobState::kRunning;
     }
   }
   const int submitted_before = active + done;
   feed(t, &active, &done);
   if (!t.active()) return false;  // a submission failed the timelapse
   changed = changed || active + done != submitted_before;
-  const std::string state = done == n || done > 0 || started ? "running" : "queued";
+  const JobState state = done == n || done > 0 || started ? JobState::kRunning : JobState::kQueued;
   if (state != t.record.state) {
     t.record.state = state;
     changed = true;
@@ -196,14 +194,14 @@ void TimelapseService::feed(Entry& t, int* active, int* done) {
     render_id = submitted.id;
     jobs_.set_group(render_id, t.record.id);
     const std::optional<JobSummary> s = jobs_.summary(render_id);
-    if (s && s->state == "done") ++*done;
+    if (s && s->state == JobState::kDone) ++*done;
     else ++*active;
   }
 }
 
 void TimelapseService::fail(Entry& t, const std::string& message) {
   cancel_frames(t);
-  t.record.state = "failed";
+  t.record.state = JobState::kFailed;
   t.record.failure = message;
   t.record.finished_unix = unix_now();
   persist(t);
@@ -265,7 +263,7 @@ void TimelapseService::build_outputs(const std::string& id) {
   t.record.contact_sheet = true;
   t.record.video = report.video;
   t.record.video_reason = report.video_reason;
-  t.record.state = "done";
+  t.record.state = JobState::kDone;
   t.record.finished_unix = unix_now();
   persist(t);
 }
@@ -288,9 +286,9 @@ SubmitResult TimelapseService::submit(const api::TimelapseRequest& request, cons
   int active = 0;
   for (const auto& id : order_) {
     const Entry& t = *timelapses_.at(id);
-    if (t.canonical == canonical && (t.active() || t.record.state == "done")) {
+    if (t.canonical == canonical && (t.active() || t.record.state == JobState::kDone)) {
       if (key) idempotency_[*key] = t.record.id;
-      return {t.record.id, false, t.record.state == "done"};
+      return {t.record.id, false, t.record.state == JobState::kDone};
     }
     active += t.active();
   }
@@ -326,7 +324,7 @@ bool TimelapseService::cancel(const std::string& id) {
   Entry& t = *it->second;
   if (!t.active()) return true;
   cancel_frames(t);
-  t.record.state = "cancelled";
+  t.record.state = JobState::kCancelled;
   t.record.finished_unix = unix_now();
   persist(t);
   return true;
@@ -335,12 +333,12 @@ bool TimelapseService::cancel(const std::string& id) {
 // --- Status ---------------------------------------------------------------------
 
 nlohmann::json TimelapseService::video_json(const Entry& t, int frames_done) const {
-  const std::string& state = t.record.state;
+  const JobState state = t.record.state;
   nlohmann::json reason = nullptr;
-  if (state == "done") {
+  if (state == JobState::kDone) {
     if (!t.record.video) reason = t.record.video_reason;
-  } else if (state == "failed" || state == "cancelled") {
-    reason = "the timelapse " + std::string(state == "failed" ? "failed" : "was cancelled") + ": no video";
+  } else if (state == JobState::kFailed || state == JobState::kCancelled) {
+    reason = "the timelapse " + std::string(state == JobState::kFailed ? "failed" : "was cancelled") + ": no video";
   } else if (const FfmpegLookup ffmpeg = find_ffmpeg(options_.ffmpeg); !ffmpeg.path) {
     reason = ffmpeg.reason + "; the frames and the contact sheet are made without it";
   } else if (t.building) {
@@ -349,7 +347,7 @@ nlohmann::json TimelapseService::video_json(const Entry& t, int frames_done) con
     reason = "made when every frame is done (" + std::to_string(frames_done) + " of " +
              std::to_string(t.frame_count()) + " done)";
   }
-  return {{"available", state == "done" && t.record.video}, {"reason", reason}, {"fps", t.request.video_fps}};
+  return {{"available", state == JobState::kDone && t.record.video}, {"reason", reason}, {"fps", t.request.video_fps}};
 }
 
 nlohmann::json TimelapseService::status_of(const Entry& t) const {
@@ -362,16 +360,16 @@ nlohmann::json TimelapseService::status_of(const Entry& t) const {
     const std::string& render_id = t.record.render_ids[static_cast<std::size_t>(i)];
     const std::optional<JobSummary> s = render_id.empty() ? std::nullopt : jobs_.summary(render_id);
     // A frame never submitted is "queued" while its timelapse is active.
-    const std::string state = s ? s->state : t.active() ? "queued" : "cancelled";
+    const JobState state = s ? s->state : t.active() ? JobState::kQueued : JobState::kCancelled;
     const double fraction = s ? s->fraction : 0.0;
-    done += state == "done";
+    done += state == JobState::kDone;
     fraction_sum += fraction;
     const std::string frame = self + "/frames/" + std::to_string(i);
     const bool has_ev = t.record.exposure_ev100.size() == static_cast<std::size_t>(n);
     frames.push_back({{"index", i},
                       {"time", t.request.frame_time_text(i)},
                       {"render_id", render_id.empty() ? nlohmann::json(nullptr) : nlohmann::json(render_id)},
-                      {"state", state},
+                      {"state", to_string(state)},
                       {"progress", fraction},
                       {"estimated_relative_rms", s ? optional_json(s->estimated_relative_rms) : nlohmann::json(nullptr)},
                       {"exposure_ev100", has_ev ? nlohmann::json(t.record.exposure_ev100[static_cast<std::size_t>(i)])
@@ -381,18 +379,18 @@ nlohmann::json TimelapseService::status_of(const Entry& t) const {
                         {"exr", frame + ".exr"},
                         {"png", frame + ".png"}}}});
   }
-  const std::string& state = t.record.state;
+  const JobState state = t.record.state;
   nlohmann::json stage = nullptr;
   if (t.active()) stage = t.building || done == n ? "making_outputs" : "rendering";
   const auto& exposure = t.request.base.output.exposure_ev;
   return {{"id", t.record.id},
-          {"state", state},
+          {"state", to_string(state)},
           {"stage", stage},
           {"failure", t.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.record.failure)},
           {"created_unix", t.record.created_unix},
           {"finished_unix", t.active() ? nlohmann::json(nullptr) : nlohmann::json(t.record.finished_unix)},
           {"progress",
-           {{"fraction", state == "done" ? 1.0 : fraction_sum / n}, {"frames_done", done}, {"frames_total", n}}},
+           {{"fraction", state == JobState::kDone ? 1.0 : fraction_sum / n}, {"frames_done", done}, {"frames_total", n}}},
           {"method", t.request.base.method == api::Method::kLut ? "lut" : "path"},
           {"same_seed", t.request.same_seed},
           {"exposure",
@@ -400,7 +398,7 @@ nlohmann::json TimelapseService::status_of(const Entry& t) const {
             {"ev100", optional_json(exposure)},
             {"smoothing_frames", exposure ? nlohmann::json(nullptr) : nlohmann::json(t.request.exposure_smoothing_frames)}}},
           {"frames", frames},
-          {"contact_sheet", {{"available", state == "done" && t.record.contact_sheet}}},
+          {"contact_sheet", {{"available", state == JobState::kDone && t.record.contact_sheet}}},
           {"video", video_json(t, done)},
           {"request", t.record.request},
           {"links",
@@ -443,7 +441,7 @@ TimelapseFile TimelapseService::frame_image(const std::string& id, int index, Im
       return {TimelapseFile::Status::kUnknownFrame, std::nullopt,
               "timelapse \"" + id + "\" has frames 0 to " + std::to_string(t.frame_count() - 1)};
     // Once done, the PNG is the timelapse's own (the sequence's exposure).
-    if (format == ImageFormat::kPng && t.record.state == "done")
+    if (format == ImageFormat::kPng && t.record.state == JobState::kDone)
       return {TimelapseFile::Status::kOk,
               ImageFile{frame_png_path(dir_of(id), index), "\"" + id + "-" + std::to_string(index) + "\"", true}, ""};
     render_id = t.record.render_ids[static_cast<std::size_t>(index)];
@@ -452,7 +450,7 @@ TimelapseFile TimelapseService::frame_image(const std::string& id, int index, Im
               "frame " + std::to_string(index) + " has no render yet" +
                   (t.active() ? ": at most " + std::to_string(options_.frames_in_flight) +
                                     " frames of a timelapse render at once, in frame order"
-                              : ": the timelapse is " + t.record.state)};
+                              : ": the timelapse is " + to_string(t.record.state))};
   }
   std::optional<ImageFile> file = jobs_.image(render_id, format);
   if (!file)
@@ -469,10 +467,10 @@ TimelapseFile TimelapseService::contact_sheet(const std::string& id) const {
   const auto it = timelapses_.find(id);
   if (it == timelapses_.end()) return {TimelapseFile::Status::kUnknownTimelapse, std::nullopt, ""};
   const Entry& t = *it->second;
-  if (t.record.state == "done" && t.record.contact_sheet)
+  if (t.record.state == JobState::kDone && t.record.contact_sheet)
     return {TimelapseFile::Status::kOk, ImageFile{dir_of(id) / "contact_sheet.png", "\"" + id + "-sheet\"", true}, ""};
   return {TimelapseFile::Status::kNotReady, std::nullopt,
-          "timelapse \"" + id + "\" is " + t.record.state +
+          "timelapse \"" + id + "\" is " + to_string(t.record.state) +
               ": the contact sheet is made once, when every frame is done"};
 }
 
@@ -481,13 +479,13 @@ TimelapseFile TimelapseService::video(const std::string& id) const {
   const auto it = timelapses_.find(id);
   if (it == timelapses_.end()) return {TimelapseFile::Status::kUnknownTimelapse, std::nullopt, ""};
   const Entry& t = *it->second;
-  if (t.record.state == "done" && t.record.video)
+  if (t.record.state == JobState::kDone && t.record.video)
     return {TimelapseFile::Status::kOk, ImageFile{dir_of(id) / "video.mp4", "\"" + id + "-video\"", true}, ""};
-  if (t.record.state == "done")
+  if (t.record.state == JobState::kDone)
     return {TimelapseFile::Status::kUnavailable, std::nullopt,
             "timelapse \"" + id + "\" has no video: " + t.record.video_reason};
   return {TimelapseFile::Status::kNotReady, std::nullopt,
-          "timelapse \"" + id + "\" is " + t.record.state + ": the video is made once, when every frame is done"};
+          "timelapse \"" + id + "\" is " + to_string(t.record.state) + ": the video is made once, when every frame is done"};
 }
 
 }  // namespace skyfarm::server

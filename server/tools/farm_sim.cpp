@@ -340,8 +340,8 @@ FarmSimResult run_farm_sim(const FarmSimOptions& o) {
   limits.max_queue_units = std::max<int>(limits.max_queue_units, static_cast<int>(std::min<std::int64_t>(expected, 1 << 30)));
   JobService service(dir.path, limits);
   std::atomic<int> finished{0};
-  service.set_state_observer([&](const std::string&, const std::string& state) {
-    if (state == "done" || state == "failed" || state == "cancelled") ++finished;
+  service.set_state_observer([&](const std::string&, JobState state) {
+    if (is_terminal(state)) ++finished;
   });
   ProbeLimits probe_limits;
   probe_limits.unit_timeout_s = std::min(limits.unit_timeout_s, kProbeUnitTimeoutCapS);

@@ -17,7 +17,7 @@
 #include "api/curve_keys.h"
 #include "api/render_request.h"
 #include "api/wire.h"
-#include "server/jobs/job_service.h"
+#include "server/broker/broker_backend.h"
 
 namespace skyfarm::testing {
 

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_request.h"
-#include "server/jobs/job_service.h"
+#include "server/http/http_backend.h"
 
 namespace skyfarm::server::testing {
 

@@ -126,17 +126,17 @@ TEST(TimelapseScheduling, GroupsOfUnknownJobsAndSummaries) {
   EXPECT_FALSE(service.set_group("nope", "g"));
   EXPECT_FALSE(service.summary("nope").has_value());
   const std::string id = service.submit(api::parse_render_request(frame_request(7)), std::nullopt).id;
-  std::vector<std::pair<std::string, std::string>> seen;
-  service.set_state_observer([&](const std::string& job, const std::string& state) { seen.emplace_back(job, state); });
+  std::vector<std::pair<std::string, JobState>> seen;
+  service.set_state_observer([&](const std::string& job, JobState state) { seen.emplace_back(job, state); });
   const auto s = service.summary(id);
   ASSERT_TRUE(s);
-  EXPECT_EQ(s->state, "queued");
+  EXPECT_EQ(s->state, JobState::kQueued);
   EXPECT_EQ(s->fraction, 0.0);
   EXPECT_FALSE(s->estimated_relative_rms.has_value());
   service.cancel(id);
-  EXPECT_EQ(service.summary(id)->state, "cancelled");
+  EXPECT_EQ(service.summary(id)->state, JobState::kCancelled);
   ASSERT_EQ(seen.size(), 1u);
-  EXPECT_EQ(seen[0], std::make_pair(id, std::string("cancelled")));
+  EXPECT_EQ(seen[0], std::make_pair(id, JobState::kCancelled));
   service.set_state_observer({});
 }
 

@@ -1,0 +1,44 @@
+#include "server/jobs/job.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/atmosphere/atmosphere_builder.h"
+#include "common/render/render_progress.h"
+
+namespace skyfarm::server {
+
+WorkUnit unit_at(const RenderPlan& plan, std::size_t i) {
+  const std::size_t per_pass = static_cast<std::size_t>(plan.tile_count()) * static_cast<std::size_t>(plan.batches);
+  const std::size_t rem = i % per_pass;
+  return WorkUnit{static_cast<int>(rem / static_cast<std::size_t>(plan.batches)),
+                  static_cast<int>(rem % static_cast<std::size_t>(plan.batches)), static_cast<int>(i / per_pass)};
+}
+
+std::int64_t waiting_units(const RenderPlan& plan, std::int64_t merged) {
+  const std::int64_t per_pass = static_cast<std::int64_t>(plan.tile_count()) * plan.batches;
+  return std::max<std::int64_t>(0, std::min(plan.unit_count() - merged, per_pass * kQueueHorizonPasses));
+}
+
+std::string unit_text(const WorkUnit& u) {
+  return "tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) + ", pass " + std::to_string(u.pass);
+}
+
+nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& plan) {
+  nlohmann::json constituents = nlohmann::json::array(), skipped = nlohmann::json::array();
+  const Atmosphere atmosphere = build_atmosphere(request.atmosphere);
+  for (const auto& c : atmosphere.constituents()) constituents.push_back(c.name);
+  if (request.atmosphere.preset != AtmospherePreset::kCustom) {
+    if (request.atmosphere.ozone_du <= 0.0) skipped.push_back("ozone");
+    if (!request.atmosphere.aerosol || request.atmosphere.aerosol->optical_depth_550 <= 0.0)
+      skipped.push_back("aerosol");
+  }
+  return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
+          {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
+          {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
+          {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control},
+          {"shadow_guide", plan.shadow_guide},     {"adaptive", plan.adaptive},
+          {"pooled_ground_row", plan.pooled_ground_row >= 0 ? nlohmann::json(plan.pooled_ground_row) : nlohmann::json()}};
+}
+
+}  // namespace skyfarm::server
