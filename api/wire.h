@@ -186,24 +186,4 @@ inline std::vector<std::uint8_t> payload_bytes(const std::string& payload) {
   return {payload.begin(), payload.end()};
 }
 
-// --- Wake-up pipe -------------------------------------------------------------
-// A non-blocking self-pipe the broker and worker I/O threads add to their
-// zmq_poll set (as a file descriptor), so other threads can wake them
-// without touching their sockets: notify() is thread-safe and
-// async-signal-safe; drain() (owner thread) empties it.
-class WakeupPipe {
- public:
-  WakeupPipe();
-  ~WakeupPipe();
-  WakeupPipe(const WakeupPipe&) = delete;
-  WakeupPipe& operator=(const WakeupPipe&) = delete;
-
-  int read_fd() const { return fds_[0]; }
-  void notify() const noexcept;
-  void drain() const noexcept;
-
- private:
-  int fds_[2] = {-1, -1};
-};
-
 }  // namespace skyfarm::api

@@ -22,6 +22,7 @@
 #include "api/render_request.h"
 #include "api/render_setup.h"
 #include "api/wire.h"
+#include "common/core/wakeup_pipe.h"
 #include "common/film/film_tile.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
@@ -117,7 +118,7 @@ api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
 // for the I/O thread, which is woken through the pipe.
 class RenderPool {
  public:
-  RenderPool(int threads, std::size_t cache_jobs, const api::WakeupPipe& wakeup)
+  RenderPool(int threads, std::size_t cache_jobs, const WakeupPipe& wakeup)
       : setups_(cache_jobs), wakeup_(wakeup) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
   }
@@ -183,7 +184,7 @@ class RenderPool {
   }
 
   Setups setups_;
-  const api::WakeupPipe& wakeup_;
+  const WakeupPipe& wakeup_;
   std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<RenderTask> tasks_;
@@ -213,7 +214,7 @@ struct FarmWorker::Impl {
   std::atomic<bool> drain{false};
   std::atomic<bool> paused{false};
   std::atomic<bool> running{false};
-  api::WakeupPipe wakeup;
+  WakeupPipe wakeup;
   struct Counters {
     std::atomic<std::uint64_t> sessions{0}, units_received{0}, results_sent{0}, failures_sent{0},
         cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0}, auth_failures{0};
