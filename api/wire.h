@@ -32,9 +32,10 @@
 // Unit kinds: "render" (kind absent) is a render unit (tile, batch, pass of
 // the job's RenderPlan) answered with FilmTile bytes.  "probe" is a unit of a
 // radiance probe (request: the ProbeRequest's canonical text; tile = the
-// unit's index in api::probe_plan, batch = pass = 0) answered with
-// ProbeUnitSums bytes (common/render/probe_units.h); the server sends them
-// only to workers whose READY capabilities hold "probe": kProbeUnitsVersion.
+// unit's index in its probe_plan, common/render/probe_answer.h; batch = pass
+// = 0) answered with ProbeUnitSums bytes (common/render/probe_units.h); the
+// server sends them only to workers whose READY capabilities hold "probe":
+// kProbeUnitsVersion.
 //
 // prefetch: units the worker accepts beyond its `slots`, queued behind the
 // ones it renders (absent or 0: none, the server sends at most `slots`).  The

@@ -20,7 +20,7 @@
 #include <zmq_addon.hpp>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "api/wire.h"
 #include "common/core/wakeup_pipe.h"
 #include "common/film/film_tile.h"
@@ -41,7 +41,7 @@ constexpr Ms kMaxTick{100};  // longest poll: latency of drain_flag and of pause
 
 // What renders the units of one render job.
 struct JobRenderer {
-  api::RenderSetup setup;
+  RenderSetup setup;
   std::unique_ptr<TileRenderer> renderer;
 };
 
@@ -49,7 +49,7 @@ JobRenderer make_job_renderer(const std::string& request_text) {
   try {
     const api::RenderRequest request = api::parse_render_request(request_text);
     JobRenderer job;
-    job.setup = api::make_render_setup(request);
+    job.setup = make_render_setup(api::render_spec(request));
     job.renderer = std::make_unique<TileRenderer>(*job.setup.scene, *job.setup.camera, job.setup.plan);
     return job;
   } catch (const api::ValidationError& ex) {

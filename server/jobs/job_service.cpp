@@ -11,7 +11,7 @@
 #include <set>
 #include <sstream>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/atmosphere/atmosphere_builder.h"
 #include "common/film/film_tile.h"
 #include "common/image/atomic_file.h"
