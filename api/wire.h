@@ -32,9 +32,10 @@
 // Unit kinds: "render" (kind absent) is a render unit (tile, batch, pass of
 // the job's RenderPlan) answered with FilmTile bytes.  "probe" is a unit of a
 // radiance probe (request: the ProbeRequest's canonical text; tile = the
-// unit's index in api::probe_plan, batch = pass = 0) answered with
-// ProbeUnitSums bytes (common/render/probe_units.h); the server sends them
-// only to workers whose READY capabilities hold "probe": kProbeUnitsVersion.
+// unit's index in its probe_plan, common/render/probe_answer.h; batch = pass
+// = 0) answered with ProbeUnitSums bytes (common/render/probe_units.h); the
+// server sends them only to workers whose READY capabilities hold "probe":
+// kProbeUnitsVersion.
 //
 // prefetch: units the worker accepts beyond its `slots`, queued behind the
 // ones it renders (absent or 0: none, the server sends at most `slots`).  The
@@ -185,25 +186,5 @@ std::optional<Message> try_decode(const Frames& frames, std::string* error = nul
 inline std::vector<std::uint8_t> payload_bytes(const std::string& payload) {
   return {payload.begin(), payload.end()};
 }
-
-// --- Wake-up pipe -------------------------------------------------------------
-// A non-blocking self-pipe the broker and worker I/O threads add to their
-// zmq_poll set (as a file descriptor), so other threads can wake them
-// without touching their sockets: notify() is thread-safe and
-// async-signal-safe; drain() (owner thread) empties it.
-class WakeupPipe {
- public:
-  WakeupPipe();
-  ~WakeupPipe();
-  WakeupPipe(const WakeupPipe&) = delete;
-  WakeupPipe& operator=(const WakeupPipe&) = delete;
-
-  int read_fd() const { return fds_[0]; }
-  void notify() const noexcept;
-  void drain() const noexcept;
-
- private:
-  int fds_[2] = {-1, -1};
-};
 
 }  // namespace skyfarm::api

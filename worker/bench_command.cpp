@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 #include "common/render/parallel.h"
 #include "worker/bench_convergence.h"
@@ -41,7 +41,7 @@ struct Timed {
 // Renders a parsed request into memory (no files) with `threads` threads.
 Timed render_request(const api::RenderRequest& request, int threads) {
   const auto t0 = std::chrono::steady_clock::now();
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   Image image(setup.plan.width, setup.plan.height);
   Timed t;

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/film/error_estimate.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
@@ -61,7 +61,7 @@ std::vector<double> luminance_of(const std::vector<FilmTile>& film, int width, i
 // The sun disk's pixels (a 5x5 block around its centre): a few pixels 1e6
 // times brighter than the sky, hit or missed by chance, would otherwise be
 // the whole luminance-weighted error.  Both errors leave them out.
-std::vector<bool> sky_mask(const api::RenderSetup& setup) {
+std::vector<bool> sky_mask(const RenderSetup& setup) {
   std::vector<bool> keep(64 * 32, true);
   double fx = 0.0, fy = 0.0;
   if (!setup.scene->sun().is_point() && setup.camera->direction_to_film(setup.scene->sun().direction(), &fx, &fy))
@@ -131,7 +131,7 @@ std::vector<double> reference(const Scene_& s, int passes, const fs::path& dir) 
   if (std::ifstream in(cache, std::ios::binary); in && in.read(reinterpret_cast<char*>(Y.data()), Y.size() * sizeof(double)))
     return Y;
   const auto request = api::parse_render_request(request_json(s, passes * 16, 987654321));
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   StopCriteria stop;
   stop.after_pass = [&](int pass, const std::vector<FilmTile>& film, double) {
@@ -260,7 +260,7 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     if (!only.empty() && only != s.name) continue;
     const std::vector<double> ref = reference(s, passes * 16, dir);
     const auto request = api::parse_render_request(request_json(s, passes * 16, seed));
-    api::RenderSetup setup = api::make_render_setup(request);
+    RenderSetup setup = make_render_setup(api::render_spec(request));
     if (roulette_control) setup.plan.roulette_control = *roulette_control;
     if (shadow_guide) setup.plan.shadow_guide = *shadow_guide;
     setup.plan.adaptive = adaptive;

@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/image/png_writer.h"
 #include "common/render/local_render.h"
 
@@ -42,7 +42,7 @@ struct SkyFrame {
 };
 
 SkyFrame render_frame(const std::string& json) {
-  const api::RenderSetup setup = api::make_render_setup(api::parse_render_request(json));
+  const RenderSetup setup = make_render_setup(api::render_spec(api::parse_render_request(json)));
   const auto t0 = std::chrono::steady_clock::now();
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   ImageLayers layers;

@@ -20,8 +20,9 @@
 #include <zmq_addon.hpp>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "api/wire.h"
+#include "common/core/wakeup_pipe.h"
 #include "common/film/film_tile.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
@@ -40,7 +41,7 @@ constexpr Ms kMaxTick{100};  // longest poll: latency of drain_flag and of pause
 
 // What renders the units of one render job.
 struct JobRenderer {
-  api::RenderSetup setup;
+  RenderSetup setup;
   std::unique_ptr<TileRenderer> renderer;
 };
 
@@ -48,7 +49,7 @@ JobRenderer make_job_renderer(const std::string& request_text) {
   try {
     const api::RenderRequest request = api::parse_render_request(request_text);
     JobRenderer job;
-    job.setup = api::make_render_setup(request);
+    job.setup = make_render_setup(api::render_spec(request));
     job.renderer = std::make_unique<TileRenderer>(*job.setup.scene, *job.setup.camera, job.setup.plan);
     return job;
   } catch (const api::ValidationError& ex) {
@@ -117,7 +118,7 @@ api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
 // for the I/O thread, which is woken through the pipe.
 class RenderPool {
  public:
-  RenderPool(int threads, std::size_t cache_jobs, const api::WakeupPipe& wakeup)
+  RenderPool(int threads, std::size_t cache_jobs, const WakeupPipe& wakeup)
       : setups_(cache_jobs), wakeup_(wakeup) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
   }
@@ -183,7 +184,7 @@ class RenderPool {
   }
 
   Setups setups_;
-  const api::WakeupPipe& wakeup_;
+  const WakeupPipe& wakeup_;
   std::mutex mutex_;
   std::condition_variable cv_;
   std::deque<RenderTask> tasks_;
@@ -213,7 +214,7 @@ struct FarmWorker::Impl {
   std::atomic<bool> drain{false};
   std::atomic<bool> paused{false};
   std::atomic<bool> running{false};
-  api::WakeupPipe wakeup;
+  WakeupPipe wakeup;
   struct Counters {
     std::atomic<std::uint64_t> sessions{0}, units_received{0}, results_sent{0}, failures_sent{0},
         cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0}, auth_failures{0};

@@ -20,11 +20,12 @@
 //   between a result leaving and the next unit arriving.  A worker started
 //   with --threads 1 (the server's embedded local workers) holds 2 units:
 //   one rendering while the next arrives.
-// Setups: api::make_render_setup (a probe's scene and plan) is cached per
-//   job id (worker/setup_cache.h: LRU of setup_cache_jobs = 4 jobs each for
-//   renders and probes; an entry is rebuilt if the job's request text
-//   differs).  A request that does not parse, an out-of-range unit or any
-//   exception while rendering is answered with FAILED and the message.
+// Setups: a render's make_render_setup (a probe's make_probe_setup) is
+//   cached per job id (worker/setup_cache.h: LRU of setup_cache_jobs = 4
+//   jobs each for renders and probes; an entry is rebuilt if the job's
+//   request text differs).  A request that does not parse, an out-of-range
+//   unit or any exception while rendering is answered with FAILED and the
+//   message.
 // Probe units (UNIT kind "probe", worker/probe_unit.h) run on the same
 //   render threads and slots as render units; READY advertises them with
 //   the capability "probe": api::kProbeUnitsVersion.

@@ -4,7 +4,8 @@
 #include <stdexcept>
 
 #include "api/field_error.h"
-#include "api/probe_answer.h"
+#include "api/probe_spec.h"
+#include "common/render/probe_answer.h"
 
 namespace skyfarm {
 
@@ -12,11 +13,11 @@ ProbeSetup make_probe_setup(const std::string& request_text) {
   try {
     api::ProbeRequest request = api::parse_probe_request(request_text);
     if (request.method != api::Method::kPath) throw std::runtime_error("probe units are path traced; method is lut");
-    Scene scene = api::probe_scene(request);
-    std::vector<glm::dvec3> directions = api::probe_directions(request);
-    const ProbePlan plan = api::probe_plan(request);
-    std::shared_ptr<const RadianceControl> control = api::probe_roulette_control(request, scene);
-    return ProbeSetup{std::move(request), std::move(scene), std::move(directions), plan, std::move(control)};
+    ProbeSpec spec = api::probe_spec(request);
+    Scene scene = probe_scene(spec);
+    const ProbePlan plan = probe_plan(spec);
+    std::shared_ptr<const RadianceControl> control = probe_roulette_control(spec, scene);
+    return ProbeSetup{std::move(request), std::move(scene), std::move(spec.directions), plan, std::move(control)};
   } catch (const api::ValidationError& e) {
     throw std::runtime_error(std::string("invalid probe request: ") + e.what());
   } catch (const std::exception& e) {

@@ -1,9 +1,9 @@
 // The farm worker's probe units (api/wire.h, UNIT kind "probe"): the
-// request is a ProbeRequest's canonical text, tile is the unit's index in
-// api::probe_plan(request); the answer is a RESULT carrying the unit's
-// ProbeUnitSums (common/render/probe_units.h), traced on the calling thread
-// exactly as `skyfarm-worker probe` traces that unit, or FAILED with the
-// reason (a request that does not parse or is not a "path" probe, a unit
+// request is a ProbeRequest's canonical text, tile is the unit's index in its
+// probe_plan (common/render/probe_answer.h); the answer is a RESULT carrying
+// the unit's ProbeUnitSums (common/render/probe_units.h), traced on the
+// calling thread exactly as `skyfarm-worker probe` traces that unit, or
+// FAILED with the reason (a request that does not parse or is not a "path" probe, a unit
 // outside the plan, anything the tracer throws).
 #pragma once
 #include <memory>
@@ -25,7 +25,7 @@ struct ProbeSetup {
   Scene scene;
   std::vector<glm::dvec3> directions;
   ProbePlan plan;
-  std::shared_ptr<const RadianceControl> control;  // api::probe_roulette_control
+  std::shared_ptr<const RadianceControl> control;  // probe_roulette_control
 };
 
 // Throws std::runtime_error naming what is wrong with the request.

@@ -12,7 +12,8 @@
 #include "api/probe_request.h"
 #include "api/render_request.h"
 #include "api/probe_answer.h"
-#include "api/render_setup.h"
+#include "api/probe_spec.h"
+#include "api/render_spec.h"
 #include "common/core/constants.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
@@ -68,7 +69,7 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
 int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
                     int threads, const std::string& label, int png_bits = 8) {
   const auto t0 = std::chrono::steady_clock::now();
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const Scene& scene = *setup.scene;
   const RenderPlan& plan = setup.plan;
   const TileRenderer renderer(scene, *setup.camera, plan);
@@ -206,7 +207,7 @@ int run_probe_command(const std::vector<std::string>& args) {
   }
   try {
     const api::ProbeRequest request = api::parse_probe_request(text);
-    const nlohmann::json out = api::answer_probe(request, threads);
+    const nlohmann::json out = api::probe_answer_json(request, answer_probe(api::probe_spec(request), threads));
     std::cout << out.dump(2) << "\n";
     return 0;
   } catch (const api::ValidationError& e) {

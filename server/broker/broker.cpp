@@ -16,6 +16,7 @@
 
 #include "api/curve_keys.h"
 #include "api/wire.h"
+#include "common/core/wakeup_pipe.h"
 
 namespace skyfarm::server {
 namespace {
@@ -47,7 +48,7 @@ constexpr std::size_t kMaxCancelledRemembered = 1024;
 
 struct Broker::Shared {
   std::atomic<bool> stop{false};
-  api::WakeupPipe wakeup;
+  WakeupPipe wakeup;
   std::atomic<std::uint64_t> workers{0}, joined{0}, left{0}, lost{0}, rejected{0}, units_sent{0}, results{0},
       failures{0}, cancels_sent{0}, malformed{0}, unexpected{0}, reregisters_sent{0}, backend_errors{0},
       auth_failures{0}, results_refused{0};

@@ -20,6 +20,7 @@
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
 #include "api/probe_answer.h"
+#include "api/probe_spec.h"
 
 namespace skyfarm::server {
 namespace {
@@ -481,7 +482,7 @@ void HttpApi::sky_radiance(const Request& req, Response& res, const ContentReade
   if (request.wavelengths_nm.size() > kMaxLutWavelengths)
     throw api::ValidationError({api::FieldError{"wavelengths_nm", "at most 64 wavelengths with method lut on the server",
                                                 std::to_string(request.wavelengths_nm.size())}});
-  send_json(res, 200, api::answer_probe(request, 1));
+  send_json(res, 200, api::probe_answer_json(request, answer_probe(api::probe_spec(request), 1)));
 }
 void HttpApi::sky_envmap(const Request& req, Response& res) { sky_->envmap(req, res); }
 

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <sstream>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/sampling/sampler.h"
 #include "common/sun/sun.h"
 #include "server/jobs/disk_budget.h"

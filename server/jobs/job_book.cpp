@@ -2,7 +2,7 @@
 
 #include <algorithm>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/camera/camera.h"
 #include "common/render/sun_pixels.h"
 #include "common/sun/sun.h"

@@ -1,6 +1,6 @@
 #include "server/jobs/job_images.h"
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/image/atomic_file.h"
 #include "server/jobs/job_errors.h"
 

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "api/probe_answer.h"
+#include "api/probe_spec.h"
 #include "common/render/probe_units.h"
 
 namespace skyfarm::server {
@@ -131,7 +132,8 @@ ProbeService::~ProbeService() = default;
 
 nlohmann::json ProbeService::run(const api::ProbeRequest& request, std::chrono::milliseconds timeout) {
   if (request.method != api::Method::kPath) throw std::invalid_argument("ProbeService runs path-traced probes only");
-  const ProbePlan plan = api::probe_plan(request);
+  const ProbeSpec spec = api::probe_spec(request);
+  const ProbePlan plan = probe_plan(spec);
   std::unique_lock lock(impl_->mu);
   if (impl_->closed) throw NoProbeWorkers("the server is shutting down");
   if (impl_->workers.empty()) {
@@ -164,7 +166,8 @@ nlohmann::json ProbeService::run(const api::ProbeRequest& request, std::chrono::
   }
   ++impl_->counters.done;
   lock.unlock();
-  return api::path_probe_answer(request, probe->reduction.result(request.wavelengths_nm.size()));
+  const ProbeResult result = probe->reduction.result(request.wavelengths_nm.size());
+  return api::probe_answer_json(request, path_probe_answer(spec, result));
 }
 
 void ProbeService::close() {

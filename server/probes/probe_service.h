@@ -1,6 +1,6 @@
 // Path-traced radiance probes through the farm (POST /v1/sky/radiance with
 // "method": "path"; DESIGN §5.2, issue 6): a probe is cut into units
-// (api::probe_plan, common/render/probe_units.h), the units go to the
+// (probe_plan, common/render/probe_answer.h), the units go to the
 // workers through the ZeroMQ broker next to render units (ProbeRouter,
 // probe_router.h, asks this service first), and their sums are reduced here
 // in canonical order, so the answer is the same document, number for
@@ -81,7 +81,8 @@ class ProbeService final : public BrokerBackend {
   ProbeService(const ProbeService&) = delete;
   ProbeService& operator=(const ProbeService&) = delete;
 
-  // Traces a "path" probe on the farm and returns api::path_probe_answer.
+  // Traces a "path" probe on the farm and returns its answer document
+  // (api/probe_answer.h).
   // Throws NoProbeWorkers, CapacityExceeded, ProbeTimedOut, ProbeFailed, or
   // std::invalid_argument for a "lut" probe.
   nlohmann::json run(const api::ProbeRequest& request, std::chrono::milliseconds timeout);

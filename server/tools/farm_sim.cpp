@@ -15,7 +15,7 @@
 
 #include "api/curve_keys.h"
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "api/wire.h"
 #include "common/film/film_tile.h"
 #include "common/render/render_plan.h"

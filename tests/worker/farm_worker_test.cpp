@@ -16,8 +16,8 @@
 #include <mutex>
 #include <thread>
 
-#include "api/probe_answer.h"
-#include "api/render_setup.h"
+#include "api/probe_spec.h"
+#include "api/render_spec.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
 #include "server/broker/broker.h"
@@ -35,7 +35,7 @@ using skyfarm::testing::tiny_request;
 
 // What `skyfarm-worker render` computes for one unit.
 std::vector<std::uint8_t> local_unit_bytes(const std::string& request, int tile, int batch, int pass) {
-  const api::RenderSetup setup = api::make_render_setup(api::parse_render_request(request));
+  const RenderSetup setup = make_render_setup(api::render_spec(api::parse_render_request(request)));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   FilmTile film = renderer.empty_tile(tile);
   PathCounters counters;
@@ -442,12 +442,13 @@ TEST_F(FarmWorkerTest, ProbeUnitsAreTracedAsTheLocalProbeDoes) {
   });
   start_worker();
   ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() + f.failed.size() == 3; }, 10s));
-  const ProbePlan plan = api::probe_plan(probe);
-  const Scene scene = api::probe_scene(probe);
-  ASSERT_TRUE(api::probe_roulette_control(probe, scene)) << "sun 40 deg from the zenith";
+  const ProbeSpec spec = api::probe_spec(probe);
+  const ProbePlan plan = probe_plan(spec);
+  const Scene scene = probe_scene(spec);
+  ASSERT_TRUE(probe_roulette_control(spec, scene)) << "sun 40 deg from the zenith";
   const std::vector<std::uint8_t> expected =
-      trace_probe_unit(scene, api::probe_directions(probe), probe.wavelengths_nm, probe.seed, plan.unit(0),
-                       api::probe_roulette_control(probe, scene))
+      trace_probe_unit(scene, spec.directions, probe.wavelengths_nm, probe.seed, plan.unit(0),
+                       probe_roulette_control(spec, scene))
           .serialize();
   backend_.with_lock([&](auto& f) {
     EXPECT_EQ(f.joined.at(0).second["capabilities"]["probe"], api::kProbeUnitsVersion);

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/core/constants.h"
 #include "common/render/local_render.h"
 #include "common/render/radiance_probe.h"
@@ -145,7 +145,7 @@ TEST(ExtremeCases, OneNanometreAndOnePixel) {
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 45, "azimuth_deg": 0},
     "camera": {"projection": "perspective", "width": 1, "height": 1}, "spectral": {"min_nm": 550, "max_nm": 551},
     "quality": {"samples_per_pixel": 32}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   Image image(1, 1);
   const LocalRenderResult r = render_image(renderer, &image, 1);

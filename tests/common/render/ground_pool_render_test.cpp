@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -43,7 +43,7 @@ TEST(GroundPoolPlan, RowsThatLookOnlyDownFromAnObserverOnTheGround) {
     std::string text = body;
     text.replace(text.find("%s"), 2, extra);
     const auto request = api::parse_render_request(text);
-    return api::make_render_setup(request).plan;
+    return make_render_setup(api::render_spec(request)).plan;
   };
   EXPECT_EQ(plan_of("").pooled_ground_row, 17);
   EXPECT_EQ(plan_of(R"(, "location": {"altitude_m": 1})").pooled_ground_row, -1);
@@ -66,7 +66,7 @@ TEST(GroundPoolRender, PooledGroundAgreesWithTheTracedGroundAndTheSkyIsTheSameBi
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 40, "azimuth_deg": 100},
     "camera": {"projection": "equirectangular", "width": 64, "height": 32},
     "spectral": {"batches": 1}, "quality": {"samples_per_pixel": 64}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   ASSERT_EQ(setup.plan.pooled_ground_row, 17);
   const TileRenderer pooled_renderer(*setup.scene, *setup.camera, setup.plan);
   Image pooled(64, 32);

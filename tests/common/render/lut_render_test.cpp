@@ -10,20 +10,20 @@
 #include <glm/geometric.hpp>
 
 #include "api/render_request.h"
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
 namespace {
 
 struct Rendered {
-  api::RenderSetup setup;
+  RenderSetup setup;
   Image image{1, 1};
 };
 
 Rendered render(const std::string& json) {
   Rendered r;
-  r.setup = api::make_render_setup(api::parse_render_request(json));
+  r.setup = make_render_setup(api::render_spec(api::parse_render_request(json)));
   const TileRenderer renderer(*r.setup.scene, *r.setup.camera, r.setup.plan);
   r.image = Image(r.setup.plan.width, r.setup.plan.height);
   const LocalRenderResult result = render_image(renderer, &r.image, 2);

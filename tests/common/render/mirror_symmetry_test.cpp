@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -32,7 +32,7 @@ TEST(MirrorSymmetry, HalfRenderedHalfMirroredAndPhysicallyRight) {
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 60, "azimuth_deg": 135},
     "camera": {"projection": "equirectangular", "width": 128, "height": 64, "yaw_deg": 135},
     "spectral": {"batches": 1}, "quality": {"samples_per_pixel": 32}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   ASSERT_TRUE(setup.plan.mirrored);
   EXPECT_EQ(setup.plan.tile_count(), 2 * 2);  // the left 64 columns only
   const TileRenderer half(*setup.scene, *setup.camera, setup.plan);

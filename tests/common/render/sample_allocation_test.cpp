@@ -10,7 +10,7 @@
 #include <cmath>
 #include <functional>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -131,7 +131,7 @@ struct ImageMean {
 };
 
 ImageMean render_mean(const char* request_json, int threads, ProgressiveResult* out = nullptr) {
-  const api::RenderSetup setup = api::make_render_setup(api::parse_render_request(request_json));
+  const RenderSetup setup = make_render_setup(api::render_spec(api::parse_render_request(request_json)));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   ImageMean m;
   StopCriteria stop;

@@ -21,7 +21,7 @@
 #include <random>
 #include <unistd.h>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/tile_renderer.h"
 #include "server/jobs/disk_budget.h"
 #include "server/jobs/job_ids.h"
@@ -54,7 +54,7 @@ std::string read_file(const fs::path& p) {
 // A simulated worker: renders an assignment exactly as a farm worker does,
 // with its setup cached per request (as a farm worker caches it per job).
 struct CachedSetup {
-  api::RenderSetup setup;
+  RenderSetup setup;
   std::unique_ptr<TileRenderer> renderer;
 };
 const TileRenderer& renderer_for(const std::string& request_canonical) {
@@ -62,7 +62,7 @@ const TileRenderer& renderer_for(const std::string& request_canonical) {
   auto& entry = cache[request_canonical];
   if (!entry) {
     entry = std::make_unique<CachedSetup>();
-    entry->setup = api::make_render_setup(api::parse_render_request(request_canonical));
+    entry->setup = make_render_setup(api::render_spec(api::parse_render_request(request_canonical)));
     entry->renderer = std::make_unique<TileRenderer>(*entry->setup.scene, *entry->setup.camera, entry->setup.plan);
   }
   return *entry->renderer;

@@ -9,7 +9,7 @@
 #include <random>
 #include <unistd.h>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm::server {
@@ -19,7 +19,7 @@ TEST(TileMerger, TinyMemoryBudgetStillMergesIdentically) {
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 35, "azimuth_deg": 10},
     "camera": {"projection": "equirectangular", "width": 96, "height": 64}, "spectral": {"batches": 2},
     "quality": {"samples_per_pixel": 32}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_merger_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
@@ -52,7 +52,7 @@ TEST(TileMerger, PassLimitMergesExactlyThatManyPasses) {
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 35, "azimuth_deg": 10},
     "camera": {"projection": "equirectangular", "width": 32, "height": 16}, "spectral": {"batches": 2},
     "quality": {"samples_per_pixel": 64}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   ASSERT_GE(setup.plan.passes, 4);
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_gate_" + std::to_string(::getpid()));
@@ -158,7 +158,7 @@ TEST(TileMerger, AResultOfAnotherSizeIsRefusedAndFilesAreCountedAndRemoved) {
   const auto request = api::parse_render_request(R"({"sun": {"zenith_deg": 35, "azimuth_deg": 10},
     "camera": {"projection": "equirectangular", "width": 48, "height": 16}, "spectral": {"batches": 2},
     "quality": {"samples_per_pixel": 16}})");
-  const api::RenderSetup setup = api::make_render_setup(request);
+  const RenderSetup setup = make_render_setup(api::render_spec(request));
   const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
   const auto dir = std::filesystem::temp_directory_path() / ("skyfarm_merger_size_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

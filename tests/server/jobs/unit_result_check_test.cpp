@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/render/sample_allocation.h"
 #include "common/render/tile_renderer.h"
 
@@ -15,10 +15,10 @@ namespace skyfarm::server {
 namespace {
 
 struct Rendered {
-  api::RenderSetup setup;
+  RenderSetup setup;
   std::unique_ptr<TileRenderer> renderer;
   std::unique_ptr<UnitResultCheck> check;
-  explicit Rendered(const char* request) : setup(api::make_render_setup(api::parse_render_request(request))) {
+  explicit Rendered(const char* request) : setup(make_render_setup(api::render_spec(api::parse_render_request(request)))) {
     renderer = std::make_unique<TileRenderer>(*setup.scene, *setup.camera, setup.plan);
     check = std::make_unique<UnitResultCheck>(setup.plan, *setup.camera, renderer->sun_pixels());
   }

@@ -13,6 +13,7 @@
 #include <future>
 
 #include "api/probe_answer.h"
+#include "api/probe_spec.h"
 #include "tests/server/probes/probe_workers.h"
 
 namespace skyfarm::server {
@@ -30,11 +31,12 @@ api::ProbeRequest four_unit_probe(std::uint64_t seed = 3) {
 }
 
 const nlohmann::json& local_answer() {
-  static const nlohmann::json answer = api::answer_probe(four_unit_probe(), 2);
+  static const nlohmann::json answer =
+      api::probe_answer_json(four_unit_probe(), answer_probe(api::probe_spec(four_unit_probe()), 2));
   return answer;
 }
 
-TEST(ProbeService, TheFourUnitProbeIsFourUnits) { EXPECT_EQ(api::probe_plan(four_unit_probe()).unit_count(), 4u); }
+TEST(ProbeService, TheFourUnitProbeIsFourUnits) { EXPECT_EQ(probe_plan(api::probe_spec(four_unit_probe())).unit_count(), 4u); }
 
 TEST(ProbeService, AnswerIsTheLocalProbesWithOneOrThreeWorkers) {
   for (int n : {1, 3}) {

@@ -27,6 +27,7 @@
 #include "tests/support/http_fixture.h"
 #include "tests/server/probes/probe_workers.h"
 #include "api/probe_answer.h"
+#include "api/probe_spec.h"
 
 namespace skyfarm::server {
 namespace {
@@ -444,7 +445,8 @@ TEST_F(SkyHttpTest, RadianceProbeByLutAndPathTracer) {
   // passed on its standard error's share, which the roulette control shrank).
   const double x = x_doc["radiance"][0][0], y = y_doc["radiance"][0][0];
   EXPECT_NEAR(x, y, 0.08 * y + 4.0 * se);
-  EXPECT_EQ(path->body, api::answer_probe(api::parse_probe_request(body + R"(path"})"), 2).dump());
+  const api::ProbeRequest path_request = api::parse_probe_request(body + R"(path"})");
+  EXPECT_EQ(path->body, api::probe_answer_json(path_request, answer_probe(api::probe_spec(path_request), 2)).dump());
   EXPECT_EQ(path->get_header_value("Server-Timing").rfind("probe;dur=", 0), 0u);
   EXPECT_EQ(probes->stats().done, 1u);
 

@@ -13,7 +13,7 @@
 #include <memory>
 #include <thread>
 
-#include "api/render_setup.h"
+#include "api/render_spec.h"
 #include "common/image/exr_writer.h"
 #include "common/image/png_writer.h"
 #include "common/render/tile_renderer.h"
@@ -71,14 +71,14 @@ class SimulatedWorker {
 
  private:
   struct Setup {
-    api::RenderSetup setup;
+    RenderSetup setup;
     std::unique_ptr<TileRenderer> renderer;
   };
   std::vector<std::uint8_t> render(const UnitAssignment& a) {
     auto& s = setups_[a.key.job_id];
     if (!s) {
       s = std::make_unique<Setup>();
-      s->setup = api::make_render_setup(api::parse_render_request(a.request_canonical));
+      s->setup = make_render_setup(api::render_spec(api::parse_render_request(a.request_canonical)));
       s->renderer = std::make_unique<TileRenderer>(*s->setup.scene, *s->setup.camera, s->setup.plan);
     }
     FilmTile film = s->renderer->empty_tile(a.key.tile);

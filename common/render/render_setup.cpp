@@ -1,43 +1,40 @@
-#include "api/render_setup.h"
+#include "common/render/render_setup.h"
 
-namespace skyfarm::api {
+#include <string>
 
-RenderSetup make_render_setup(const RenderRequest& request) {
+namespace skyfarm {
+
+RenderSetup make_render_setup(const RenderSpec& spec) {
   RenderSetup s;
-  s.scene = std::make_unique<Scene>(Scene::from_specs(request.atmosphere, request.sun, request.location, request.time,
-                                                      request.spectral.min_nm, request.spectral.max_nm));
-  s.camera = std::make_unique<Camera>(request.camera, s.scene->observer());
-  s.plan = render_plan_for(request, s.scene->sun());
+  s.scene = std::make_unique<Scene>(Scene::from_specs(spec.atmosphere, spec.sun, spec.location, spec.time,
+                                                      spec.lambda_min_nm, spec.lambda_max_nm));
+  s.camera = std::make_unique<Camera>(spec.camera, s.scene->observer());
+  s.plan = render_plan_for(spec, s.scene->sun());
   return s;
 }
 
-RenderPlan render_plan_for(const RenderRequest& request, const Sun& sun) {
+RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun) {
   constexpr int kTileSize = 32, kSamplesPerPass = 16;
-  const bool lut = request.method == Method::kLut;
+  const bool lut = spec.lut;
   // The LUT renderer is deterministic: one sample per pixel and batch, one pass.
-  RenderPlan plan = make_render_plan(request.camera.width, request.camera.height, request.spectral.min_nm,
-                                     request.spectral.max_nm, request.spectral.batches,
-                                     lut ? 1 : request.quality.samples_per_pixel, request.seed, kTileSize,
+  RenderPlan plan = make_render_plan(spec.camera.width, spec.camera.height, spec.lambda_min_nm, spec.lambda_max_nm,
+                                     spec.batches, lut ? 1 : spec.samples_per_pixel, spec.seed, kTileSize,
                                      lut ? 1 : kSamplesPerPass,
-                                     mirror_symmetric(request.camera, sun.azimuth_deg(), kTileSize));
+                                     mirror_symmetric(spec.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
   plan.shadow_guide = !lut && shadow_guide_pays(sun.zenith_deg());
-  plan.adaptive = !lut && request.quality.adaptive && plan.passes >= 2;
+  plan.adaptive = !lut && spec.adaptive && plan.passes >= 2;
   // An observer on the ground sees one ground point in every downward
   // direction (common/film/ground_pool.h).
-  if (!lut && request.location.altitude_m == 0.0) plan.pooled_ground_row = first_ground_row(request.camera);
+  if (!lut && spec.location.altitude_m == 0.0) plan.pooled_ground_row = first_ground_row(spec.camera);
   return plan;
 }
 
-}  // namespace skyfarm::api
-
-namespace skyfarm::api {
-
-void set_render_metadata(Image* image, const RenderRequest& request, const RenderPlan& plan, const Sun& sun,
+void set_render_metadata(Image* image, std::string_view canonical_request, const RenderPlan& plan, const Sun& sun,
                          double samples_per_pixel, const ErrorSums& error) {
   namespace key = metadata_key;
-  image->set_metadata(key::kRequest, canonical_text(request));
+  image->set_metadata(key::kRequest, std::string(canonical_request));
   image->set_metadata(key::kSunZenithDeg, sun.zenith_deg());
   image->set_metadata(key::kSunAzimuthDeg, sun.azimuth_deg());
   image->set_metadata(key::kSamplesPerPixel, static_cast<double>(samples_per_pixel));
@@ -56,4 +53,4 @@ void set_render_metadata(Image* image, const RenderRequest& request, const Rende
   image->set_metadata("earth_sun_distance_au", sun.distance_au());
 }
 
-}  // namespace skyfarm::api
+}  // namespace skyfarm
