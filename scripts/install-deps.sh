@@ -13,6 +13,7 @@ packages=(
   ffmpeg
   file                        # cpack -G DEB finds the programs' libraries with it
   yamllint python3-yaml       # the deployment files' tests (tests/deploy)
+  libjson-validator-perl      # the OpenAPI document's lint (tests/api/openapi_lint.pl)
   tcpdump iproute2            # the multi-host test (tests/farm/multi_host_netns.sh)
 )
 for arg in "$@"; do

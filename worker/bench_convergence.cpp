@@ -13,7 +13,7 @@
 #include "api/render_spec.h"
 #include "common/film/error_estimate.h"
 #include "common/image/exr_writer.h"
-#include "common/image/png_writer.h"
+#include "common/film/image.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -143,54 +143,6 @@ std::vector<double> reference(const Scene_& s, int passes, const fs::path& dir) 
   return Y;
 }
 
-// A log-log plot of true (red) and estimated (blue) error against time.
-void plot(const std::vector<double>& t, const std::vector<double>& truth, const std::vector<double>& est,
-          const fs::path& path) {
-  const int W = 480, H = 320, M = 30;
-  Image img(W, H);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) img.set_rgb(x, y, Rgb{1.0, 1.0, 1.0});
-  double lt0 = 1e300, lt1 = -1e300, le0 = 1e300, le1 = -1e300;
-  for (std::size_t i = 0; i < t.size(); ++i) {
-    lt0 = std::min(lt0, std::log10(t[i]));
-    lt1 = std::max(lt1, std::log10(t[i]));
-    for (double e : {truth[i], est[i]}) {
-      if (e <= 0.0) continue;
-      le0 = std::min(le0, std::log10(e));
-      le1 = std::max(le1, std::log10(e));
-    }
-  }
-  if (lt1 <= lt0) lt1 = lt0 + 1.0;
-  if (le1 <= le0) le1 = le0 + 1.0;
-  auto px = [&](double ti, double e, int* x, int* y) {
-    *x = M + static_cast<int>((std::log10(ti) - lt0) / (lt1 - lt0) * (W - 2 * M));
-    *y = H - M - static_cast<int>((std::log10(std::max(e, 1e-300)) - le0) / (le1 - le0) * (H - 2 * M));
-  };
-  auto line = [&](int x0, int y0, int x1, int y1, Rgb c) {
-    const int n = std::max(std::abs(x1 - x0), std::abs(y1 - y0)) + 1;
-    for (int k = 0; k <= n; ++k) {
-      const int x = x0 + (x1 - x0) * k / n, y = y0 + (y1 - y0) * k / n;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          if (x + dx >= 0 && x + dx < W && y + dy >= 0 && y + dy < H) img.set_rgb(x + dx, y + dy, c);
-    }
-  };
-  line(M, H - M, W - M, H - M, Rgb{0, 0, 0});  // axes
-  line(M, M, M, H - M, Rgb{0, 0, 0});
-  for (std::size_t i = 1; i < t.size(); ++i) {
-    int x0, y0, x1, y1;
-    px(t[i - 1], truth[i - 1], &x0, &y0);
-    px(t[i], truth[i], &x1, &y1);
-    line(x0, y0, x1, y1, Rgb{0.8, 0.05, 0.05});
-    px(t[i - 1], est[i - 1], &x0, &y0);
-    px(t[i], est[i], &x1, &y1);
-    line(x0, y0, x1, y1, Rgb{0.05, 0.1, 0.8});
-  }
-  PngWriteOptions o;
-  o.exposure_ev = 3.0 + std::log2(0.18);  // scale 1: values are display values
-  write_png(img, path, o);
-}
-
 // Least-squares slope of log(error) against log(time).
 double fitted_slope(const std::vector<double>& t, const std::vector<double>& e) {
   double sx = 0, sy = 0, sxx = 0, sxy = 0, n = 0;
@@ -282,7 +234,6 @@ int run_bench_convergence(const std::vector<std::string>& args) {
     };
     Image image(64, 32);
     render_image_progressive(renderer, &image, 0, stop);
-    plot(times, truths, estimates, dir / (std::string(s.name) + ".png"));
     double worst = 1.0;
     for (std::size_t i = 0; i < truths.size(); ++i)
       if (truths[i] > 0.0 && estimates[i] > 0.0)

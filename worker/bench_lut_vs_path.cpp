@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_spec.h"
-#include "common/image/png_writer.h"
+#include "common/film/image.h"
 #include "common/render/local_render.h"
 
 namespace skyfarm {
@@ -129,48 +129,6 @@ Comparison compare(const SkyFrame& lut, const SkyFrame& path, double sun_zenith)
   return c;
 }
 
-// Relative RMS error (log scale, 0.1 % to 100 %) against sun zenith, one line per altitude.
-void plot(const std::vector<std::vector<double>>& errors, const std::vector<std::vector<double>>& reference_errors,
-          const fs::path& path) {
-  const int W = 480, H = 320, M = 30;
-  Image img(W, H);
-  for (int y = 0; y < H; ++y)
-    for (int x = 0; x < W; ++x) img.set_rgb(x, y, Rgb{1.0, 1.0, 1.0});
-  auto px = [&](double sun_zenith, double e, int* x, int* y) {
-    *x = M + static_cast<int>(sun_zenith / 96.0 * (W - 2 * M));
-    const double l = std::clamp(std::log10(std::max(e, 1e-3)), -3.0, 0.0);
-    *y = H - M - static_cast<int>((l + 3.0) / 3.0 * (H - 2 * M));
-  };
-  auto line = [&](int x0, int y0, int x1, int y1, Rgb c) {
-    const int n = std::max(std::abs(x1 - x0), std::abs(y1 - y0)) + 1;
-    for (int k = 0; k <= n; ++k) {
-      const int x = x0 + (x1 - x0) * k / n, y = y0 + (y1 - y0) * k / n;
-      for (int d = -1; d <= 1; ++d)
-        if (x >= 0 && x < W && y + d >= 0 && y + d < H) img.set_rgb(x, y + d, c);
-    }
-  };
-  line(M, H - M, W - M, H - M, Rgb{0, 0, 0});
-  line(M, M, M, H - M, Rgb{0, 0, 0});
-  for (int decade = 1; decade < 3; ++decade) {  // 1 % and 10 % grid lines
-    const int y = H - M - decade * (H - 2 * M) / 3;
-    for (int x = M; x < W - M; x += 6) img.set_rgb(x, y, Rgb{0.5, 0.5, 0.5});
-  }
-  const Rgb colours[] = {{0.8, 0.05, 0.05}, {0.05, 0.6, 0.1}, {0.05, 0.1, 0.8}};
-  for (std::size_t a = 0; a < errors.size(); ++a)
-    for (std::size_t i = 1; i < errors[a].size(); ++i) {
-      int x0, y0, x1, y1;
-      px(kSunZeniths[i - 1], reference_errors[a][i - 1], &x0, &y0);
-      px(kSunZeniths[i], reference_errors[a][i], &x1, &y1);
-      line(x0, y0, x1, y1, Rgb{0.6, 0.6, 0.6});
-      px(kSunZeniths[i - 1], errors[a][i - 1], &x0, &y0);
-      px(kSunZeniths[i], errors[a][i], &x1, &y1);
-      line(x0, y0, x1, y1, colours[a]);
-    }
-  PngWriteOptions o;
-  o.exposure_ev = 3.0 + std::log2(0.18);  // scale 1: values are display values
-  write_png(img, path, o);
-}
-
 }  // namespace
 
 int run_bench_lut_vs_path(const std::vector<std::string>& args) {
@@ -192,16 +150,11 @@ int run_bench_lut_vs_path(const std::vector<std::string>& args) {
          "reference_est_rel_rms,lut_seconds";
   for (int b = 0; b < kBatches; ++b) csv << ",band" << b << "_rel_rms";
   csv << "\n";
-  std::vector<std::vector<double>> errors, reference_errors;
   for (const double altitude : kAltitudes) {
-    errors.emplace_back();
-    reference_errors.emplace_back();
     for (const double sun_zenith : kSunZeniths) {
       const SkyFrame path = reference(sun_zenith, altitude, spp, dir);
       const SkyFrame lut = render_frame(request_json(sun_zenith, altitude, "lut", 1));
       const Comparison c = compare(lut, path, sun_zenith);
-      errors.back().push_back(c.rms_luminance);
-      reference_errors.back().push_back(path.estimated_error);
       csv << altitude << "," << sun_zenith << "," << c.rms_luminance << "," << c.max_luminance << ","
           << c.worst_zenith << "," << c.worst_azimuth << "," << path.estimated_error << "," << lut.seconds;
       for (double e : c.rms_band) csv << "," << e;
@@ -219,7 +172,6 @@ int run_bench_lut_vs_path(const std::vector<std::string>& args) {
                 << std::endl;
     }
   }
-  plot(errors, reference_errors, dir / "lut_vs_path.png");
   return 0;
 }
 

@@ -14,9 +14,9 @@
 //   per batch   relative RMS error of the band-mean spectral radiance;
 //   reference   the path tracer's own estimated relative RMS error (the
 //               comparison cannot resolve errors below it).
-// Writes DIR/lut_vs_path.csv, DIR/lut_vs_path.png (luminance relative RMS
-// error against sun zenith, one line per altitude: red 0 m, green 10 km,
-// blue 100 km; grey: the references' own error) and one JSON line per case.
+// Writes DIR/lut_vs_path.csv (scripts/plot-figures.py draws it beside it as
+// a PNG: luminance relative RMS error against sun zenith, one line per
+// altitude, and the references' own error) and one JSON line per case.
 #pragma once
 #include <string>
 #include <vector>

@@ -16,6 +16,7 @@
 #include "server/probes/http_probe.h"
 #include "server/http/http_query.h"
 #include "server/http/http_problem.h"
+#include "server/http/http_routes.h"
 #include "server/sky/http_sky.h"
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
@@ -60,7 +61,6 @@ constexpr std::time_t kKeepAliveTimeoutS = 3;
 constexpr int kMinSpareThreads = 4;        // beyond the stream slots, whatever http_threads says
 constexpr int kStreamRetryAfterS = 5;      // 503 when every stream slot is taken
 
-const char* const kIdRoute = R"(/v1/renders/([^/]+))";
 // Catch-all for methods with a body: the fallback must not read it.
 const char* const kAnyPath = R"([\s\S]*)";
 
@@ -297,34 +297,33 @@ std::function<void(const Request&, Response&)> HttpApi::guarded(Handler handler)
 }
 
 void HttpApi::add_routes(httplib::Server& server) {
-  using WithReader = httplib::Server::HandlerWithContentReader;
-  const std::string id = kIdRoute;
-  server.Post("/v1/renders", WithReader([this](const Request& req, Response& res, const ContentReader& reader) {
+  RouteRegistrar routes(server);
+  routes.post("/v1/renders", [this](const Request& req, Response& res, const ContentReader& reader) {
     run_guarded(req, res, [&] { submit(req, res, reader); });
-  }));
-  server.Get("/v1/renders", guarded(&HttpApi::list));
-  server.Get(id, guarded(&HttpApi::status));
-  server.Delete(id, WithReader([this](const Request& req, Response& res, const ContentReader&) {
+  });
+  routes.get("/v1/renders", guarded(&HttpApi::list));
+  routes.get("/v1/renders/{id}", guarded(&HttpApi::status));
+  routes.del("/v1/renders/{id}", [this](const Request& req, Response& res, const ContentReader&) {
     close_if_body_unread(req, res);  // a DELETE body means nothing here
     run_guarded(req, res, [&] { cancel(req, res); });
-  }));
-  server.Get(id + R"(/image\.exr)", guarded(&HttpApi::image_exr));
-  server.Get(id + R"(/image\.png)", guarded(&HttpApi::image_png));
-  server.Get(id + "/events", guarded(&HttpApi::events));
-  server.Get("/v1/workers", guarded(&HttpApi::workers));
-  server.Get("/v1/sky", guarded(&HttpApi::sky));
-  server.Post("/v1/sky/radiance", WithReader([this](const Request& req, Response& res, const ContentReader& reader) {
+  });
+  routes.get("/v1/renders/{id}/image.exr", guarded(&HttpApi::image_exr));
+  routes.get("/v1/renders/{id}/image.png", guarded(&HttpApi::image_png));
+  routes.get("/v1/renders/{id}/events", guarded(&HttpApi::events));
+  routes.get("/v1/workers", guarded(&HttpApi::workers));
+  routes.get("/v1/sky", guarded(&HttpApi::sky));
+  routes.post("/v1/sky/radiance", [this](const Request& req, Response& res, const ContentReader& reader) {
     run_guarded(req, res, [&] { sky_radiance(req, res, reader); });
-  }));
-  server.Get(R"(/v1/sky/envmap\.exr)", guarded(&HttpApi::sky_envmap));
-  server.Get(R"(/v1/openapi\.yaml)", guarded(&HttpApi::openapi));
-  server.Get("/healthz", guarded(&HttpApi::healthz));
-  server.Get("/metrics", guarded(&HttpApi::metrics));
-  server.Get("/", guarded(&HttpApi::web_file));
-  server.Get(kWebAssetRoute, guarded(&HttpApi::web_file));
+  });
+  routes.get("/v1/sky/envmap.exr", guarded(&HttpApi::sky_envmap));
+  routes.get("/v1/openapi.yaml", guarded(&HttpApi::openapi));
+  routes.get("/healthz", guarded(&HttpApi::healthz));
+  routes.get("/metrics", guarded(&HttpApi::metrics));
+  routes.get("/", guarded(&HttpApi::web_file));
+  routes.get("/web/{file}", guarded(&HttpApi::web_file));
   if (timelapses_)
     timelapses_->add_routes(
-        server, {[](const Request& req, Response& res, const std::function<void()>& handler) {
+        routes, {[](const Request& req, Response& res, const std::function<void()>& handler) {
                    run_guarded(req, res, handler);
                  },
                  [this](const Request& req, Response& res, const ContentReader& reader) {
@@ -336,6 +335,7 @@ void HttpApi::add_routes(httplib::Server& server) {
                    return body;
                  },
                  [](const Request& req) { return idempotency_key_of(req); }});
+  routes_ = routes.added();
 }
 
 void HttpApi::add_fallbacks(httplib::Server& server) {

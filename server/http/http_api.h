@@ -57,6 +57,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "server/http/http_events.h"
 #include "server/http/http_metrics.h"
@@ -74,6 +75,7 @@ struct Response;
 namespace skyfarm::server {
 
 class GatedHttpServer;
+struct Route;
 class SkyHttp;
 class TimelapseHttp;
 class TimelapseService;
@@ -114,6 +116,9 @@ class HttpApi {
 
   // Event streams open now (for tests and /metrics).
   int open_streams() const { return streams_.open(); }
+
+  // The routes register_routes added, as api/openapi.yaml names them.
+  const std::vector<Route>& routes() const { return routes_; }
 
  private:
   using Handler = void (HttpApi::*)(const httplib::Request&, httplib::Response&);
@@ -165,6 +170,7 @@ class HttpApi {
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
   const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
+  std::vector<Route> routes_;
 };
 
 }  // namespace skyfarm::server

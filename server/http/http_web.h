@@ -35,9 +35,6 @@ struct WebFile {
 // The embedded file served at `path`, or null.
 const WebFile* find_web_file(std::string_view path);
 
-// The routes' pattern for /web/<file> (httplib regex).
-inline constexpr const char* kWebAssetRoute = R"(/web/[^/]+)";
-
 // Answers `req.path` (200 or 304); throws a 404 HttpError for a name not embedded.
 void serve_web_file(const httplib::Request& req, httplib::Response& res);
 

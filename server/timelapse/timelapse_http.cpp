@@ -9,6 +9,7 @@
 #include "server/http/http_files.h"
 #include "server/http/http_problem.h"
 #include "server/http/http_query.h"
+#include "server/http/http_routes.h"
 
 namespace skyfarm::server {
 namespace {
@@ -20,8 +21,6 @@ using httplib::Response;
 inline constexpr std::string_view kProblemNotReady = "urn:skyfarm:problem:timelapse-file-not-ready";
 inline constexpr std::string_view kProblemVideoUnavailable = "urn:skyfarm:problem:video-unavailable";
 constexpr std::uint64_t kMaxFrameIndex = 999999;
-
-const char* const kIdRoute = R"(/v1/timelapses/([^/]+))";
 
 std::string id_of(const Request& req) {
   std::string id = req.matches.size() > 1 ? req.matches[1].str() : std::string();
@@ -51,29 +50,27 @@ TimelapseHttp::TimelapseHttp(TimelapseService& service, bool private_cache)
     : service_(service),
       cache_final_(final_cache_control(private_cache)) {}
 
-void TimelapseHttp::add_routes(httplib::Server& server, Hooks hooks) {
+void TimelapseHttp::add_routes(RouteRegistrar& routes, Hooks hooks) {
   hooks_ = std::move(hooks);
   using Handler = void (TimelapseHttp::*)(const Request&, Response&) const;
   auto guarded = [this](Handler h) {
     return [this, h](const Request& req, Response& res) { hooks_.guard(req, res, [&] { (this->*h)(req, res); }); };
   };
-  const std::string id = kIdRoute;
-  server.Post("/v1/timelapses", httplib::Server::HandlerWithContentReader(
-                                    [this](const Request& req, Response& res, const ContentReader& reader) {
-                                      hooks_.guard(req, res, [&] { submit(req, res, reader); });
-                                    }));
-  server.Get("/v1/timelapses", guarded(&TimelapseHttp::list));
-  server.Get(id, guarded(&TimelapseHttp::status));
-  server.Delete(id, httplib::Server::HandlerWithContentReader([this](const Request& req, Response& res,
-                                                                     const ContentReader&) {
+  routes.post("/v1/timelapses", [this](const Request& req, Response& res, const ContentReader& reader) {
+    hooks_.guard(req, res, [&] { submit(req, res, reader); });
+  });
+  routes.get("/v1/timelapses", guarded(&TimelapseHttp::list));
+  routes.get("/v1/timelapses/{id}", guarded(&TimelapseHttp::status));
+  routes.del("/v1/timelapses/{id}", [this](const Request& req, Response& res, const ContentReader&) {
     if (req.has_header("Content-Length") || req.has_header("Transfer-Encoding"))
       res.set_header("Connection", "close");  // a DELETE body means nothing here and stays unread
     hooks_.guard(req, res, [&] { cancel(req, res); });
-  }));
-  server.Get(id + "/frames", guarded(&TimelapseHttp::frames));
-  server.Get(id + R"(/frames/([^/]+)\.(exr|png))", guarded(&TimelapseHttp::frame_file));
-  server.Get(id + R"(/contact_sheet\.png)", guarded(&TimelapseHttp::contact_sheet));
-  server.Get(id + R"(/video\.mp4)", guarded(&TimelapseHttp::video));
+  });
+  routes.get("/v1/timelapses/{id}/frames", guarded(&TimelapseHttp::frames));
+  routes.get("/v1/timelapses/{id}/frames/{n}.exr", guarded(&TimelapseHttp::frame_file));
+  routes.get("/v1/timelapses/{id}/frames/{n}.png", guarded(&TimelapseHttp::frame_file));
+  routes.get("/v1/timelapses/{id}/contact_sheet.png", guarded(&TimelapseHttp::contact_sheet));
+  routes.get("/v1/timelapses/{id}/video.mp4", guarded(&TimelapseHttp::video));
 }
 
 void TimelapseHttp::submit(const Request& req, Response& res, const ContentReader& reader) {
@@ -121,7 +118,7 @@ void TimelapseHttp::frame_file(const Request& req, Response& res) const {
   const std::string index_text = req.matches.size() > 2 ? req.matches[2].str() : std::string();
   const auto index = parse_decimal(index_text, kMaxFrameIndex);
   if (!index) throw invalid_parameter("frame", "must be a frame index (0, 1, 2, ...)", quote_text(index_text));
-  const bool exr = req.matches.size() > 3 && req.matches[3].str() == "exr";
+  const bool exr = req.path.ends_with(".exr");  // the routes are {n}.exr and {n}.png
   const TimelapseFile file = service_.frame_image(id, static_cast<int>(*index), exr ? ImageFormat::kExr : ImageFormat::kPng);
   char name[64];
   std::snprintf(name, sizeof name, "%s-frame-%05d.%s", id.c_str(), static_cast<int>(*index), exr ? "exr" : "png");

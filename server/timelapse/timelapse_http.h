@@ -37,6 +37,8 @@ struct Response;
 
 namespace skyfarm::server {
 
+class RouteRegistrar;
+
 class TimelapseHttp {
  public:
   // What HttpApi lends to these routes, so that they behave as its own.
@@ -51,7 +53,7 @@ class TimelapseHttp {
 
   // private_cache: final files are "private" (the API needs a token).
   TimelapseHttp(TimelapseService& service, bool private_cache);
-  void add_routes(httplib::Server& server, Hooks hooks);
+  void add_routes(RouteRegistrar& routes, Hooks hooks);
 
  private:
   void submit(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
