@@ -1,4 +1,4 @@
-// The answer to a radiance probe (DESIGN §5.2), the same for the CLI
+// The answer to a radiance probe, the same for the CLI
 // (`skyfarm-worker probe`) and HTTP (POST /v1/sky/radiance):
 //   {"units", "wavelengths_nm", "directions", "radiance": [d][w],
 //    "standard_error": [d][w] (null for "lut"), "samples" (null for "lut"),

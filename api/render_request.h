@@ -1,4 +1,4 @@
-// The render request (DESIGN §5.1): parsing with field-named validation errors
+// The render request: parsing with field-named validation errors
 // and the canonical form the farm hashes.  Field by field rules:
 // docs/request-schema.md.
 #pragma once

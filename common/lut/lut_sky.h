@@ -1,4 +1,4 @@
-// The LUT renderer's sky (DESIGN §3.4): Hillaire's (2020) table-based sky,
+// The LUT renderer's sky: Hillaire's (2020) table-based sky,
 // spectral, on the same atmosphere model (Atmosphere, Sun) as the path tracer.
 // Fast and approximate; its error against the path tracer is measured in
 // tests/common/lut/sky_view_lut_test.cpp, never assumed.

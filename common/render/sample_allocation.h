@@ -1,5 +1,5 @@
-// Variance-aware sample allocation (issue 5 "more samples where the error is
-// largest, without biasing the image"): after a uniform pilot pass, every
+// Variance-aware sample allocation (more samples where the error is largest,
+// without biasing the image): after a uniform pilot pass, every
 // block of 8 x 8 pixels (RenderPlan::kAllocationBlock) gets its own number of
 // samples per pass, more where the pilot's luminance noise is larger, for
 // the same mean number of samples.

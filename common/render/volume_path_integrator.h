@@ -1,4 +1,4 @@
-// The reference spectral path tracer of the atmosphere (DESIGN §3.4).
+// The reference spectral path tracer of the atmosphere.
 //
 // Per path: kWavelengthsPerPath wavelengths; free-flight distances sampled
 // with the hero wavelength's per-shell majorant (delta tracking through the
@@ -6,7 +6,7 @@
 // scattering path integral formulation of light transport"), and the other
 // wavelengths carried by spectral MIS: r_u and r_l hold, per wavelength, the
 // path pdf had that wavelength been the hero, relative to the hero's (pbrt-v4
-// VolPathIntegrator; notes/render-core.md §1.2).  At every real scattering
+// VolPathIntegrator).  At every real scattering
 // vertex and ground hit: next-event estimation of the sun disk with
 // transmittance by ratio tracking (with Russian roulette on small
 // transmittance), combined with phase / BRDF sampling by MIS (balance

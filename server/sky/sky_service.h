@@ -1,5 +1,5 @@
-// The sky look-up service behind GET /v1/sky and GET /v1/sky/envmap.exr
-// (issue 6 §3): built LUT skies (common/lut/lut_sky.h) kept in memory, and
+// The sky look-up service behind GET /v1/sky and GET /v1/sky/envmap.exr:
+// built LUT skies (common/lut/lut_sky.h) kept in memory, and
 // the environment maps made from them.
 //
 // Two caches, both LRU, both bounded in BYTES, both thread-safe:

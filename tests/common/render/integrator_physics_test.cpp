@@ -1,4 +1,4 @@
-// Physics validation of the path tracer against closed forms (issue 3 §6).
+// Physics validation of the path tracer against closed forms.
 // Statistical tests use fixed seeds; tolerances are 4 standard errors of the
 // Monte Carlo estimate plus, where stated, a modelling allowance.
 #include <gtest/gtest.h>
@@ -362,7 +362,7 @@ TEST(IntegratorPhysics, RouletteControlKeepsTheMeanWithLessNoise) {
 // --- White furnace: a non-absorbing atmosphere over a white ground under a
 // uniform sky light L_env (no sun) has radiance L_env everywhere, from any
 // viewpoint, whatever the density profiles and phase functions (energy
-// conservation; render-core notes §5.3 item 3).
+// conservation).
 TEST(IntegratorPhysics, WhiteFurnaceReturnsTheEnvironmentRadiance) {
   AtmosphereSpec spec;
   spec.preset = AtmospherePreset::kCustom;
