@@ -62,7 +62,7 @@ struct RenderPlan {
   // (IntegratorOptions::roulette_control): path-traced renders with the sun
   // at most kRouletteControlMaxSunZenith_deg from the observer's zenith,
   // where it pays (1.1-1.4x; at 90 deg 0.96x, at twilight worse:
-  // docs/physics.md, "Roulette with a control variate").
+  // docs/experiments/2026-11-22-path-tracer-variance.md).
   bool roulette_control = false;
   static constexpr double kRouletteControlMaxSunZenith_deg = 85.0;
   // The shadow guide (IntegratorOptions::shadow_guide, shadow_guide.h):

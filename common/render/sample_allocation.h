@@ -22,8 +22,8 @@
 // per-sample standard deviation s_i and sum_i n_i fixed, sum_i s_i^2 / n_i is
 // least for n_i proportional to s_i (Lagrange); a group of pixels that shares
 // one n gets n proportional to its RMS s.  The gain over uniform n is
-// mean(s^2) / mean(s)^2 (measured: docs/physics.md "Variance-aware sample
-// allocation").
+// mean(s^2) / mean(s)^2 (measured:
+// docs/experiments/2026-11-22-sample-allocation.md).
 //
 // Why it does not bias the image: a pixel's mean over n samples is unbiased
 // when n does not depend on those samples.  Pixels are split like a

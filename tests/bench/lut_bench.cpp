@@ -15,7 +15,7 @@
 //
 // Scene: Earth preset (air, ozone 300 DU, aerosols), AM0 sun, observer on the
 // ground, 360-830 nm.  The figures quoted for the LUT sky are BM_LutBuildAll/32,
-// BM_LutBuildPerSun/32 and BM_LutRadiance/32 (docs/physics.md "The LUT sky's build time").
+// BM_LutBuildPerSun/32 and BM_LutRadiance/32 (docs/experiments/*-lut-build-time.md).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -269,7 +269,7 @@ TEST(IntegratorPhysics, ShadowGuideKeepsTheMean) {
 // alive longer (more collisions per path: the paths it used to kill carried
 // the light from the lit air), and never applies by day: the same values,
 // bit for bit.  Its effect on the error is measured in bench convergence
-// (docs/physics.md, "Efficiency"), not here: a twilight path's relative std
+// (docs/experiments/2026-11-22-path-tracer-variance.md), not here: a twilight path's relative std
 // is about 7, so a sample variance is too noisy for an assertion.
 TEST(IntegratorPhysics, ShadowRouletteThresholdKeepsTheMeanAndLeavesDaylightAlone) {
   IntegratorOptions low, one;
