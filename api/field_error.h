@@ -1,4 +1,4 @@
-// Validation errors that name the offending field (DESIGN §5: errors name the field).
+// Validation errors that name the offending field.
 #pragma once
 #include <stdexcept>
 #include <string>

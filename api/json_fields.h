@@ -1,5 +1,5 @@
-// Shared JSON field readers and writers for the requests of DESIGN §5.1 (render
-// request) and §5.2 (radiance probe): safe body parsing, error collection,
+// Shared JSON field readers and writers for the render request and the
+// radiance probe (docs/request-schema.md): safe body parsing, error collection,
 // typed field access, the fields both requests carry (location, time, sun,
 // atmosphere, method, seed) and their canonical forms.  The rules are
 // documented field by field in docs/request-schema.md.
@@ -25,7 +25,7 @@ namespace skyfarm::api {
 
 using Json = nlohmann::json;
 
-// "method": which integrator answers the request (DESIGN §3.4).
+// "method": which integrator answers the request.
 enum class Method { kPath, kLut };
 
 // --- Limits shared by the requests.
@@ -225,7 +225,8 @@ void read_time(const Fields& top, std::optional<UtcInstant>& time,
 void read_instant(const Fields& f, std::string_view name, std::optional<UtcInstant>& time,
                   std::optional<std::string>& time_text);
 void read_sun(const Fields& top, SunSpec& out);
-// DESIGN §5.1: "now" is never a default; without "time" both sun angles are needed.
+// "now" is never a default (a render must not depend on when it ran);
+// without "time" both sun angles are needed.
 void require_time_or_sun(const Fields& top);
 void read_atmosphere(const Fields& top, AtmosphereSpec& out);
 void read_method(const Fields& top, Method& out);

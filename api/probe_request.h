@@ -1,4 +1,4 @@
-// The radiance probe (DESIGN §5.2; CLI `skyfarm-worker probe`, HTTP
+// The radiance probe (CLI `skyfarm-worker probe`, HTTP
 // `POST /v1/sky/radiance`): the render request's location, time, sun and
 // atmosphere plus directions and wavelengths.  Field by field rules:
 // docs/request-schema.md.

@@ -1,4 +1,4 @@
-// The render request (DESIGN §5.1): parsing with field-named validation errors
+// The render request: parsing with field-named validation errors
 // and the canonical form the farm hashes.  Field by field rules:
 // docs/request-schema.md.
 #pragma once
@@ -24,8 +24,8 @@ namespace skyfarm::api {
 // colour.  Cut into B batches, a pixel needs B paths for one estimate of the
 // whole spectrum, and the noise of paths in different batches adds: measured
 // on a noon 128x64 equirect with the same 2^20 paths, 4 batches gave 4.58 %
-// relative RMS error and 1 batch 2.88 %, 2.9x the efficiency (docs/physics.md,
-// "Efficiency").  More batches are for spectral EXR channels (one per batch).
+// relative RMS error and 1 batch 2.88 %, 2.9x the efficiency
+// (docs/experiments/2026-11-22-path-tracer-variance.md).  More batches are for spectral EXR channels (one per batch).
 struct SpectralSpec {
   double min_nm = 360.0;
   double max_nm = 830.0;

@@ -1,4 +1,4 @@
-// The timelapse request (DESIGN §5.4, issue 7): the render request's fields
+// The timelapse request: the render request's fields
 // without "time", plus the time range and how it is cut into frames.  Field
 // by field rules: docs/request-schema.md "Timelapse request".
 //

@@ -4,8 +4,8 @@
 # varies by 10 % from run to run and the machine's speed drifts by up to
 # 1.4x within minutes, so "before" and "after" are run alternately, ROUNDS
 # times each, and the best (what a quiet machine gives) and the median of
-# every benchmark are printed side by side (the figures in docs/physics.md
-# "The LUT sky's build time" were made this way).
+# every benchmark are printed side by side (the figures in
+# docs/experiments/2026-12-02-lut-build-time.md were made this way).
 # Usage: scripts/bench-compare.sh BEFORE AFTER [ROUNDS] [FILTER]
 #   BEFORE, AFTER  two skyfarm_bench binaries (copy the first aside before rebuilding)
 #   ROUNDS         alternations (default 10)

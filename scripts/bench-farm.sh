@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The farm's benchmarks (issue 4 §9; not tests): prints one JSON line each.
+# The farm's benchmarks (not tests): prints one JSON line each.
 #   1. the same render through skyfarm-server with N local workers vs
 #      skyfarm-worker render with N threads: wall times and their ratio (median of 3)
 #   2. scheduler throughput with tiny units (a 1x1 image, 4096 units of 16 paths)

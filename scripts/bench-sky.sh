@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sky look-ups' benchmark (issue 6 §3; not a test).  One skyfarm-server
+# The sky look-ups' benchmark (not a test).  One skyfarm-server
 # (no local workers), then with skyfarm-sky-load (keep-alive, N threads, D s):
 #   1. GET /healthz                        a trivial static route (the yardstick)
 #   2. GET /v1/sky?... (warm)              the same query every time: one cached table,

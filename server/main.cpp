@@ -1,5 +1,5 @@
 // skyfarm-server: the render farm's HTTP API and ZeroMQ broker, with local
-// workers by default (DESIGN §4).  See server_options.h for the flags.
+// workers by default.  See server_options.h for the flags.
 #include <httplib.h>
 #include <signal.h>
 

@@ -1,4 +1,4 @@
-// skyfarm-server's command line (DESIGN §4.1 — the names are a contract):
+// skyfarm-server's command line (the names are a contract):
 //   --listen 127.0.0.1:8080     HTTP address           (SKYFARM_LISTEN)
 //   --broker tcp://127.0.0.1:5555  ZeroMQ ROUTER endpoint (SKYFARM_BROKER)
 //   --local-workers N           local worker processes, default: cores; 0 = none (SKYFARM_LOCAL_WORKERS)

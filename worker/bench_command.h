@@ -1,5 +1,5 @@
 // skyfarm-worker bench [paths|demo|memory|all] [--repeat N]: the renderer's
-// benchmarks (not tests; DESIGN §7).  Each prints its figures as JSON lines.
+// benchmarks (not tests).  Each prints its figures as JSON lines.
 //   paths   camera paths per second per core (one thread), noon ground-level
 //           equirectangular and sunset, 4 wavelengths per path; median of N
 //   demo    wall time of the README's demo renders on all cores; median of N

@@ -1,5 +1,5 @@
 // skyfarm-worker bench convergence [--out DIR] [--passes N]: error against
-// run time (DESIGN §6, issue 5 §3).  For each scene (noon, sun at 85 deg,
+// run time.  For each scene (noon, sun at 85 deg,
 // sunset, twilight at 96 deg, a view from 400 km, haze AOD 0.5): a converged
 // reference rendered once and cached in DIR, then a render whose true
 // relative RMS error against the reference (luminance-weighted) and whose own

@@ -1,7 +1,7 @@
 // skyfarm-worker bench efficiency [--samples N] [--sun-zenith Z ...]
 // [--shadow-scale S] [--sunlit-segments]: the integrator's efficiency
 // 1/(relative variance per path x seconds per path) over the whole sky at
-// 550 nm (DESIGN §6, issue 5 §5), for comparing estimators and options.
+// 550 nm, for comparing estimators and options.
 //
 // For each sun zenith angle (default 30, 85, 96 deg; sun at azimuth 180),
 // N paths (default 1000) in each of 36 x 24 directions (zenith 2.5..177.5

@@ -1,5 +1,5 @@
 // skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]: the LUT renderer's
-// error against converged path-traced references (issue 6 §4).
+// error against converged path-traced references.
 //
 // Cases: sun zenith 0, 30, 60, 80, 85, 90, 93, 96 deg (azimuth 180) x
 // observer altitude 0, 10 km, 100 km, Earth preset.  Each renders a 36 x 18

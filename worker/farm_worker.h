@@ -1,4 +1,4 @@
-// The farm worker: `skyfarm-worker --connect tcp://HOST:PORT` (DESIGN §4).
+// The farm worker: `skyfarm-worker --connect tcp://HOST:PORT`.
 // It connects a DEALER to the server's broker, speaks api/wire.h, and renders
 // the units it is sent with TileRenderer::render_unit, exactly as
 // `skyfarm-worker render` does, so the farm's image is bit-identical (probe

@@ -1,4 +1,4 @@
-// Aerosols (DESIGN §3.1): the vertical shape of Elterman's (1968) continental
+// Aerosols: the vertical shape of Elterman's (1968) continental
 // profile (data/elterman_1968_aerosol.csv, 0-50 km, continued above 50 km by
 // an exponential of scale height 1.2 km), scaled so that the vertical optical
 // depth from the ground to the top is tau_550 at 550 nm; the Angstrom law

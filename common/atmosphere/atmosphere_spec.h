@@ -1,5 +1,5 @@
-// The atmosphere as a request describes it (DESIGN §5.1, field names in the
-// comments).  Plain data: parsed and validated by api/, turned into a physical
+// The atmosphere as a request describes it (field names in the comments).
+// Plain data: parsed and validated by api/, turned into a physical
 // model by build_atmosphere() (common/atmosphere/atmosphere_builder.h).
 #pragma once
 #include <optional>

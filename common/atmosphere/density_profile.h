@@ -2,7 +2,7 @@
 // per-metre coefficients (dimensionless for custom constituents, molecules
 // per m^3 for Earth's air and ozone, whose coefficients are cross-sections).
 //
-// Kinds (DESIGN §5.1 "density"):
+// Kinds:
 //   exponential  rho(h) = exp(-h / H)
 //   table        piecewise linear in h, 0 outside the table's altitudes
 //   layers       Bruneton (2017) layers: clamp(a e^{s h} + l h + c, 0, 1)

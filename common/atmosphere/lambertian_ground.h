@@ -1,5 +1,5 @@
-// The ground: a Lambertian reflector with a scalar or spectral albedo rho(lambda)
-// (DESIGN §3.1), BRDF f = rho / pi, sampled proportionally to cos(theta).
+// The ground: a Lambertian reflector with a scalar or spectral albedo
+// rho(lambda), BRDF f = rho / pi, sampled proportionally to cos(theta).
 #pragma once
 #include <glm/vec3.hpp>
 

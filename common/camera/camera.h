@@ -1,4 +1,4 @@
-// The camera: pixels -> primary rays, and back (DESIGN §5.1 "camera").
+// The camera: pixels -> primary rays, and back.
 //
 // Parameters (CameraSpec, all angles in degrees)
 //   projection  equirectangular | fisheye | perspective
@@ -54,7 +54,8 @@
 // image circle; other pixels are never traced and stay zero.  Every direction
 // returned is a unit vector, finite at the equirect poles and fisheye centre.
 //
-// All arithmetic in double precision (DESIGN §3.6: no fast-math, no float).
+// All arithmetic in double precision, no fast-math: the same bits on every
+// worker, and rays that stay exact at planetary scale.
 #pragma once
 
 #include <glm/vec3.hpp>

@@ -1,4 +1,4 @@
-// "camera" of a render request (DESIGN §5.1).  Plain data, validated by api/.
+// "camera" of a render request.  Plain data, validated by api/.
 #pragma once
 
 namespace skyfarm {

@@ -17,7 +17,7 @@ inline constexpr double kBoltzmann = 1.380649e-23;
 inline constexpr double kDobsonUnit_per_m2 = 2.6867e20;
 // Astronomical unit, m (IAU 2012 exact).
 inline constexpr double kAstronomicalUnit_m = 1.495978707e11;
-// Mean Earth radius, m (DESIGN §3.1 default planet radius).
+// Mean Earth radius, m.
 inline constexpr double kEarthRadius_m = 6371000.0;
 // Default top of the atmosphere above the ground, m.
 inline constexpr double kDefaultTopAltitude_m = 100000.0;

@@ -1,4 +1,4 @@
-// The image-level estimate of a render's own error (DESIGN §6): per pixel the
+// The image-level estimate of a render's own error: per pixel the
 // variance of the luminance mean from the film's sums; per image the
 // luminance-weighted relative RMS error against the true image Y,
 //     e = sqrt( sum_i var(Y_i) / sum_i Y_i^2 ),

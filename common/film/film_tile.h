@@ -1,6 +1,6 @@
 // FilmTile: the per-pixel sums of one rectangular tile of an image, for B
 // wavelength batches, as a unit of work returns them and the server merges
-// them (DESIGN.md §4: "Sums are merged, never averages of averages").
+// them (sums are merged, never averages of averages).
 //
 // Parameters
 //   x0, y0     the tile's top-left pixel in image coordinates (≥ 0; x to the
@@ -44,7 +44,7 @@
 // Merging is elementwise addition (a.sum += b.sum for every double, in
 // storage order).  Floating-point addition is not associative, so the result
 // is bit-identical only when the caller merges the same tiles in the same
-// order; the server fixes that order (DESIGN.md §4, determinism).
+// order; the server fixes that order.
 //
 // Wire format (serialize / deserialize; all integers and doubles little-endian,
 // independent of the host):

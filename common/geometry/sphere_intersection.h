@@ -1,5 +1,5 @@
 // Ray / sphere intersection at planetary scale, in double precision with a
-// numerically stable quadratic (notes/render-core.md pitfall 13).
+// numerically stable quadratic.
 //
 // For a ray o + t d (|d| = 1) and a sphere of radius R centred at the origin:
 //   t^2 + 2 b t + c = 0,  b = o.d,  c = |o|^2 - R^2 = (r - R)(r + R), r = |o|.

@@ -1,4 +1,4 @@
-// OpenEXR output of an Image (DESIGN.md §3.3: absolute units, Rec.709/D65,
+// OpenEXR output of an Image (absolute units, Rec.709/D65,
 // optional spectral channels after the published spectral-OpenEXR layout),
 // and a reader for tests and tools.
 //

@@ -1,6 +1,6 @@
 // Monochromatic radiance in given directions from the LUT renderer (the
-// `"method": "lut"` of `skyfarm-worker probe` and POST /v1/sky/radiance,
-// DESIGN §5.2): for each asked wavelength, tables with ONE spectral bin of
+// `"method": "lut"` of `skyfarm-worker probe` and POST /v1/sky/radiance):
+// for each asked wavelength, tables with ONE spectral bin of
 // width 1 nm centred on it (so the value is the radiance at that wavelength
 // of the sun's spectrum averaged over 1 nm, like the path tracer's), then a
 // look-up per direction, sun disk included.  Deterministic: no standard

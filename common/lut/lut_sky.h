@@ -1,4 +1,4 @@
-// The LUT renderer's sky (DESIGN §3.4): Hillaire's (2020) table-based sky,
+// The LUT renderer's sky: Hillaire's (2020) table-based sky,
 // spectral, on the same atmosphere model (Atmosphere, Sun) as the path tracer.
 // Fast and approximate; its error against the path tracer is measured in
 // tests/common/lut/sky_view_lut_test.cpp, never assumed.
@@ -60,22 +60,13 @@
 // The approximation spreads the light of the aerosols' forward peak over all
 // directions (with an isotropic scatterer the LUT agrees to 1.2 %).
 //
-// Cost (tests/bench/lut_bench.cpp, one core of a shared 2-core AMD EPYC VM,
-// CPU time, medians, 8 / 32 bins, observer on the ground): all tables
-// 20.5 / 27.6 ms since the multiple-scattering table's mirror-paired
-// directions and the sky view's one-value ground rows (26 / 36-40 ms in
-// quiet runs before; 86 ms at 32 bins before the tables moved to huge
-// pages: page faults cost ~11 us each on this VM); the sun-dependent tables alone (with_sun) 6 /
-// 7.4 ms for an observer on the ground; one radiance look-up 84 / 107-139
-// ns; memory 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).
-// On a noisier 2.3 GHz Xeon VM, all tables at 32 bins 30.2 ms at best (39.0
-// in the same runs before single precision where the tables are stored,
-// compile-time bin counts in the per-view passes, no zero-fill of tables
-// written in full and reused table memory).  On an AMD EPYC (Zen 5) VM,
-// 12.6 / 18.0 ms at best (19.8 ms median at 32 bins; 16.7 / 24.6 before the
-// transmittance table's tangent table and thin rows, prefetched coefficient
-// rows and single-precision phases), with_sun 5.5 ms.  Where the time goes and what
-// bounds it: docs/physics.md "The LUT sky's build time".  A timelapse or a
+// Cost (tests/bench/lut_bench.cpp, one core, CPU time, 8 / 32 bins,
+// observer on the ground): all tables about 13 / 18-20 ms on the AMD EPYC
+// (Zen 5) VM they were last measured on (slower VMs take up to ~1.5x), the
+// sun-dependent tables alone (with_sun) about 5.5 ms at 32 bins; one
+// radiance look-up ~0.1 us; memory 5.7 / 16.4 MB (whole 2 MiB pages,
+// huge_page_allocator.h).  Where the time goes, what bounds it and
+// how it got there: docs/experiments/*-lut-build-time.md.  A timelapse or a
 // cache of many suns should build once and call with_sun.
 #pragma once
 #include <atomic>

@@ -29,8 +29,8 @@
 // T_sun is the transmittance LUT (0 where the planet hides the sun), so
 // twilight points still gather light from the sunlit air above them.  The
 // integrals over w are the means over the direction set; the marches use
-// segment_integral.h per step.  f_ms is clamped to <= 1 - 1e-3 (render-core
-// pitfall 12: a conservative, optically thick medium drives it to 1); the
+// segment_integral.h per step.  f_ms is clamped to <= 1 - 1e-3 (a
+// conservative, optically thick medium drives it to 1); the
 // number of nodes clamped is kept in clamped_nodes().
 #pragma once
 #include <algorithm>

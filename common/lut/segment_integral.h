@@ -12,7 +12,7 @@
 // "Physically based and unified volumetric rendering in Frostbite", 2015,
 // slide 28).
 //
-// Numerics (notes/render-core.md pitfall 11): the textbook
+// Numerics: the textbook
 // (1 - exp(-sigma_t dt)) / sigma_t is 0/0 for sigma_t = 0 (an empty layer,
 // or a coefficient that underflowed) and loses all digits to cancellation
 // for tiny x.  Here x = sigma_t dt is formed first; for x < 1e-4 the Taylor

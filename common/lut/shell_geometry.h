@@ -5,8 +5,7 @@
 //
 // All in double precision: with r ~ 6.4e6 m the squared terms are ~4e13 m^2;
 // the discriminants below are formed as r^2 mu^2 - (r - R)(r + R), which
-// keeps the small difference r^2 - R^2 exact for rays near the ground
-// (notes/render-core.md pitfall 13).
+// keeps the small difference r^2 - R^2 exact for rays near the ground.
 #pragma once
 #include <algorithm>
 #include <cmath>

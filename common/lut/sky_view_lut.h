@@ -19,8 +19,8 @@
 // Cost: the march of each row (steps, coefficients, exponentials) is done
 // once and shared by all its columns, which only repeat the sun-dependent
 // look-ups (rows share the altitude profile of their zenith angle); those
-// dominate (108 x 192 x 30 of them, docs/physics.md "The LUT sky's build
-// time").  Stored in single precision (2.7 MB at 32 bins; the table's own
+// dominate (108 x 192 x 30 of them,
+// docs/experiments/2026-11-22-lut-build-time.md).  Stored in single precision (2.7 MB at 32 bins; the table's own
 // error is ~1 %).
 #pragma once
 #include <cstddef>

@@ -3,7 +3,7 @@
 // resolved into the output image.  The result does not depend on the thread
 // count.  Also reports the image-level estimated relative RMS error of
 // luminance, sqrt(sum_i var(Y_i) / sum_i Y_i^2) over the pixels with an
-// estimate (ErrorSums::relative_rms; DESIGN §6).
+// estimate (ErrorSums::relative_rms).
 #pragma once
 #include <functional>
 #include <optional>
@@ -33,7 +33,7 @@ struct LocalRenderResult {
 LocalRenderResult render_image(const TileRenderer& renderer, Image* image, int threads,
                                const RenderProgress& progress = {});
 
-// When to stop before the plan's last sample (DESIGN §6 quality modes): after
+// When to stop before the plan's last sample: after
 // the first whole pass at which the estimated relative RMS error is at most
 // the target, or the first whole pass completed after the time limit.
 struct StopCriteria {

@@ -1,5 +1,5 @@
-// A radiance probe (radiance_probe.h) cut into units of work for the farm
-// (DESIGN §4, §5.2), and the one canonical way their sums are combined, so
+// A radiance probe (radiance_probe.h) cut into units of work for the farm,
+// and the one canonical way their sums are combined, so
 // that the answer's bits depend on the request alone: `skyfarm-worker probe`
 // (every unit on local threads) and the farm (units on any number of
 // workers, results arriving in any order) trace the same units and reduce

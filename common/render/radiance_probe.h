@@ -1,5 +1,5 @@
 // Monochromatic radiance in given directions from the observer
-// (`skyfarm-worker probe`, DESIGN §5.2): for each direction and each
+// (`skyfarm-worker probe`): for each direction and each
 // wavelength, the mean of `samples` path-traced estimates at exactly that
 // wavelength and its standard error (sample standard deviation / sqrt(n)).
 // The work is the probe's units (probe_units.h) traced on local threads and

@@ -1,4 +1,4 @@
-// How a render is cut into units of work (DESIGN §4): image tiles x
+// How a render is cut into units of work: image tiles x
 // wavelength batches x sample passes.  A pure function of the request, so a
 // unit means the same samples wherever and whenever it is rendered.
 //
@@ -51,7 +51,7 @@ struct RenderPlan {
   int samples_per_pass = 16;
   int passes = 1;
   std::uint64_t seed = 1;
-  // Mirror symmetry (DESIGN §3.5): when the view is symmetric about the sun's
+  // Mirror symmetry: when the view is symmetric about the sun's
   // vertical plane, only columns [0, width / 2) are rendered (tiles cover
   // them alone) and the right half is their mirror image (mirror_image.h).
   bool mirrored = false;
@@ -62,7 +62,7 @@ struct RenderPlan {
   // (IntegratorOptions::roulette_control): path-traced renders with the sun
   // at most kRouletteControlMaxSunZenith_deg from the observer's zenith,
   // where it pays (1.1-1.4x; at 90 deg 0.96x, at twilight worse:
-  // docs/physics.md, "Roulette with a control variate").
+  // docs/experiments/2026-11-22-path-tracer-variance.md).
   bool roulette_control = false;
   static constexpr double kRouletteControlMaxSunZenith_deg = 85.0;
   // The shadow guide (IntegratorOptions::shadow_guide, shadow_guide.h):
@@ -76,7 +76,7 @@ struct RenderPlan {
   // request asks for it ("quality.adaptive").
   bool adaptive = false;
   static constexpr int kAllocationBlock = 8;
-  // The ground under an observer at 0 m (DESIGN §3.5, film/ground_pool.h):
+  // The ground under an observer at 0 m (film/ground_pool.h):
   // rows [pooled_ground_row, height) look only at the ground at the
   // observer's feet, all with the same radiance; each of their pixels traces
   // one sample per pass (sample index = the pass) and their sums are pooled

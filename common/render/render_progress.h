@@ -1,5 +1,5 @@
-// How far a render has come towards the first of its limits (DESIGN §6
-// quality modes: samples, target error, time limit), for progress bars and
+// How far a render has come towards the first of its limits (the quality
+// modes: samples, target error, time limit), for progress bars and
 // ETAs.  A request that stops by a target error or a time limit alone has
 // no sample cap (1048576 samples per pixel), so the share of its samples
 // done says nothing: a 512x256 frame asked for "1 % in at most 2 minutes"

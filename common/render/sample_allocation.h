@@ -1,5 +1,5 @@
-// Variance-aware sample allocation (issue 5 "more samples where the error is
-// largest, without biasing the image"): after a uniform pilot pass, every
+// Variance-aware sample allocation (more samples where the error is largest,
+// without biasing the image): after a uniform pilot pass, every
 // block of 8 x 8 pixels (RenderPlan::kAllocationBlock) gets its own number of
 // samples per pass, more where the pilot's luminance noise is larger, for
 // the same mean number of samples.
@@ -22,8 +22,8 @@
 // per-sample standard deviation s_i and sum_i n_i fixed, sum_i s_i^2 / n_i is
 // least for n_i proportional to s_i (Lagrange); a group of pixels that shares
 // one n gets n proportional to its RMS s.  The gain over uniform n is
-// mean(s^2) / mean(s)^2 (measured: docs/physics.md "Variance-aware sample
-// allocation").
+// mean(s^2) / mean(s)^2 (measured:
+// docs/experiments/2026-11-22-sample-allocation.md).
 //
 // Why it does not bias the image: a pixel's mean over n samples is unbiased
 // when n does not depend on those samples.  Pixels are split like a

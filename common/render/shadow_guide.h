@@ -28,7 +28,7 @@
 // horizon (RenderPlan::shadow_guide); 8 x 12 nodes of 32 x 24 cells march
 // 73 728 rays through coarse LUT tables (~0.14 s on one core, 1.2 MB; 12
 // altitudes of 48 x 32 cells cost 0.5 s for no gain).  Measured in
-// docs/physics.md, "The shadow guide".
+// docs/experiments/2026-12-02-twilight.md.
 #pragma once
 #include <vector>
 

@@ -1,7 +1,7 @@
 // The pixels that see the sun disk.  A few pixels 1e6 times brighter than
 // the sky, whose samples hit or miss the 0.27-degree disk by chance, would
-// otherwise make up the whole luminance-weighted error estimate of an image
-// (DESIGN §6): the image-level estimate leaves them out (their own per-pixel
+// otherwise make up the whole luminance-weighted error estimate of an image:
+// the image-level estimate leaves them out (their own per-pixel
 // error is still in the EXR's error layer).
 #pragma once
 #include <cstdint>

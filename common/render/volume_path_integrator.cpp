@@ -562,7 +562,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
 }
 
 // Single scattering of sunlight along a segment, sampled where the sun is
-// visible (DESIGN §3.4; issue 5 "sampling the distance towards the sun"):
+// visible:
 //   L_ss = int_sunlit T(o, x_t) sigma_s(x_t) p(theta) T(x_t, sun) L_sun dt.
 // The sunlit part of the segment is the line minus the planet's shadow
 // (sunlit_intervals.h).  t is drawn there from the majorant's truncated

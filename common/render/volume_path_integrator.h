@@ -1,4 +1,4 @@
-// The reference spectral path tracer of the atmosphere (DESIGN §3.4).
+// The reference spectral path tracer of the atmosphere.
 //
 // Per path: kWavelengthsPerPath wavelengths; free-flight distances sampled
 // with the hero wavelength's per-shell majorant (delta tracking through the
@@ -6,7 +6,7 @@
 // scattering path integral formulation of light transport"), and the other
 // wavelengths carried by spectral MIS: r_u and r_l hold, per wavelength, the
 // path pdf had that wavelength been the hero, relative to the hero's (pbrt-v4
-// VolPathIntegrator; notes/render-core.md §1.2).  At every real scattering
+// VolPathIntegrator).  At every real scattering
 // vertex and ground hit: next-event estimation of the sun disk with
 // transmittance by ratio tracking (with Russian roulette on small
 // transmittance), combined with phase / BRDF sampling by MIS (balance
@@ -55,30 +55,23 @@ struct IntegratorOptions {
   // planet's shadow (1 elsewhere), and survivors carry it: a twilight path
   // scattering in the dark air is still on its way to the lit air, where
   // most of its value lies, and killing it at its throughput's odds made
-  // the rare survivors the heavy tail of the image.  Measured (bench
-  // convergence, twilight 96 deg, 512 spp, against an 8192-spp reference):
-  // true error 0.233 -> 0.165, estimate/true at 16 spp 0.34 -> 0.66, for
-  // about 1.2x the collisions; day vertices never use it (the same bytes).
+  // the rare survivors the heavy tail of the image.  Day vertices never use
+  // it (the same bytes).
   double rr_threshold_in_shadow = 0.25;
   // Camera rays whose majorants promise fewer than this many tentative
   // collisions inflate them (up to max_camera_majorant_scale) so that each
   // gathers the sun in expectation at about this many points (see the .cpp).
-  // Off (scale 1): it paid 2-3x at noon and sunset before camera rays had a
-  // forced collision; with one it lowers the chance that the ray scatters
-  // on (the multiple scattering), and without it the image errors fell at
-  // equal samples (128x64 equirect, 256 spp: noon 2.23 -> 2.10 %, 85 deg
-  // 4.92 -> 4.83 %, sunset 11.57 -> 11.44 %, haze 3.61 -> 3.60 %, 400 km
-  // 2.32 -> 2.26 %, twilight 25.2 -> 22.4 %) for 2.8 % (noon) to 4 % (sunset)
-  // more instructions (cachegrind, 32x16 at 64 spp).
+  // Off (scale 1): it paid before camera rays had a forced collision; with
+  // one it only lowers the chance that the ray scatters on (the multiple
+  // scattering), and without it the images are less noisy at equal samples
+  // for slightly fewer instructions.
   double camera_target_collisions = 1.0;
   double max_camera_majorant_scale = 1.0;
   // Inflation of the (coarse) majorants on shadow rays: ratio tracking's
   // relative variance is about exp(tau / scale) - 1, so looser bounds trade
-  // collisions for much less noise on long, grazing shadow rays.  Measured
-  // (image-level efficiency at 550 nm, 36x24 directions, /tmp-style probe
-  // in docs/physics.md "Efficiency"): 4 against 1 gave 1.12x at noon, 1.06x
-  // with the sun at 85 deg and 1.57x at twilight (96 deg); 8 and 16 lose
-  // again to the extra collisions.
+  // collisions for much less noise on long, grazing shadow rays; 4 is the
+  // best of the scales measured (8 and 16 lose again to the extra
+  // collisions).
   double shadow_majorant_scale = 4.0;
   // Shadow rays and the sunlit-segment estimator's transmittances by residual
   // ratio tracking against a per-shell control extinction
@@ -87,30 +80,26 @@ struct IntegratorOptions {
   bool residual_ratio_tracking = true;
   // ... on shadow rays whose cosine to the local zenith is below this (air
   // mass above ~3): on short shadow rays plain ratio tracking through the 9
-  // coarse shells is as good and cheaper than crossing ~40 fine shells
-  // (measured in docs/physics.md, "Efficiency").
+  // coarse shells is as good and cheaper than crossing ~40 fine shells.
   double residual_tracking_below_cos = 0.35;
   // ... and on shadow rays that start below this altitude, whatever their
   // angle: they cross the aerosol layer (scale height ~1.2 km), where the
   // coarse shells' majorants are loosest.  The ground's sun NEE is most of
   // the bright lower half of a ground-level panorama, and the image error is
-  // luminance-weighted: 128x64 equirect, 256 spp, estimated error (CPU s):
-  // noon 2.87 % (3.4) -> 2.23 % (4.15), haze (AOD 0.5) 4.11 % (5.3) ->
-  // 3.61 % (5.4), 400 km 2.76 % (3.1) -> 2.32 % (3.8): 1.3-1.4x the
-  // efficiency (0 m alone: 1.35x at noon, 1.03x in the haze).
+  // luminance-weighted, so these rays matter more than their share of
+  // directions.
   double residual_tracking_below_altitude_m = 3000.0;
   // The sun's scattered light from a sunlit-segment estimator on every
   // segment of the path (camera ray and each ray after a vertex), sampled in
   // the lit part of the segment (see the .cpp), instead of NEE at tentative
   // collisions.  Off by default: by day it lowers the error per sample a
-  // little (noon 2.14 % -> 2.02 % at 512 spp on bench convergence) but costs
-  // about 1.5x the time per path.
+  // little but costs about 1.5x the time per path.
   bool explicit_single_scattering = false;
   // ... on the segments the planet's shadow cuts or that start with the sun
   // below their local horizontal (twilight, and rays towards the dark side at
   // sunset): collisions rarely reach their sunlit part, or find the sun only
   // through long grazing air; the estimator samples the lit part alone.
-  // Never at day (the same bytes as without).  Measured in docs/physics.md.
+  // Never at day (the same bytes as without).
   bool sunlit_segments_in_shadow = true;
   // At medium vertices in the planet's shadow, this share of the scattering
   // directions is drawn from a von Mises-Fisher lobe (kappa 10) aimed at the
@@ -120,10 +109,11 @@ struct IntegratorOptions {
   // Forced collisions on the path's first segments (0: none, 1: the camera
   // ray, 2: and the ray after the first vertex, ...): both "no tentative
   // collision along the whole segment" (weight T_maj) and "at least one"
-  // (the first drawn within the segment) are followed (see the .cpp).  The
-  // "none" branch is a recursive call, so this also bounds the nesting.
-  // 8 against 2: relative std per path 0.55 -> 0.48 at noon and 1.04 ->
-  // 0.91 at 85 deg for about the same cost (docs/physics.md, "Efficiency").
+  // (the first drawn within the segment) are followed (see the .cpp), so
+  // every camera ray gathers the sun in the air.  The "none" branch is a
+  // recursive call, so this also bounds the nesting.  8 costs about what 2
+  // did (deeper segments mostly leave the atmosphere) and is less noisy;
+  // more gains nothing.
   int forced_collision_segments = 8;
   // Russian roulette with a control variate (radiance_control.h) at vertices
   // outside the planet's shadow: a path that ends adds c, an approximation
@@ -131,22 +121,19 @@ struct IntegratorOptions {
   // towards the next direction times the throughput); one that goes on adds
   // (X - c) / s.  Unbiased whatever c is; survival is raised where needed so
   // that no path's sum turns negative.  Null: plain roulette.  Built per job
-  // when the sun is up (RenderPlan::roulette_control, where it pays).
-  // Measured (bench convergence, 64x32, 512 spp, true error and user CPU s):
-  // noon 1.59 % (1.79) -> 1.30 % (1.97), 400 km 1.76 % (2.06) -> 1.34 %
-  // (2.56), haze 2.85 % (3.10) -> 2.39 % (3.3-3.6): 1.25-1.39x the
-  // efficiency; 1.1-1.2x with the sun at 60-85 deg, 0.96x at 90 (more in
-  // docs/physics.md, "Roulette with a control variate").
+  // when the sun is high enough for it to pay (RenderPlan::roulette_control).
   std::shared_ptr<const RadianceControl> roulette_control;
   // At medium vertices where the sun is below the local horizontal, this
   // share of the scattering directions is drawn from a table of the light
   // arriving there (shadow_guide.h: the LUT sky at the vertex's altitude and
   // sun angle, not the observer's), in place of the von Mises-Fisher lobe
-  // above; the pdf is the mixture with the phase function's.  Null: the
-  // lobe.  Built per job when the sun is below the observer's horizon
-  // (RenderPlan::shadow_guide).  Twilight (96 deg), bench convergence, 512
-  // spp, 16 seeds: true error RMS 0.30 -> 0.20, median 0.31 -> 0.18, for
-  // ~1.1x the time per path (docs/physics.md, "The shadow guide").
+  // above: from high vertices the lit air and the sun's aureole lie just
+  // below the horizontal, where the lobe rarely sends a path.  The pdf is the
+  // mixture with the phase function's.  Null: the lobe.  Built per job when
+  // the sun is below the observer's horizon (RenderPlan::shadow_guide).
+  //
+  // What each option measured: docs/experiments/2026-11-22-path-tracer-
+  // variance.md and docs/experiments/2026-12-02-twilight.md.
   std::shared_ptr<const ShadowGuide> shadow_guide;
   double shadow_guide_fraction = 0.3;
 };

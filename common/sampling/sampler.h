@@ -1,7 +1,6 @@
 // Deterministic random numbers: every number a path uses is a pure function
 // of (job seed, pixel, sample index, dimension), so a work unit rendered twice,
-// on another worker, or split into passes in any order gives the same bits
-// (DESIGN §3.4, issue 3 "Determinism").
+// on another worker, or split into passes in any order gives the same bits.
 //
 // Counter-based: u = to_unit(hash(seed, pixel, sample, dimension)), where the
 // hash chains MurmurHash3's 64-bit finaliser (Appleby 2011) over the four

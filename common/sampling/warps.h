@@ -19,7 +19,8 @@
 // Frame(n): a right-handed orthonormal basis (s, t, n) from a unit vector n,
 // branch-free except for the sign of n.z (Duff et al. 2017).
 //
-// All arithmetic in double precision (DESIGN §3.6: no fast-math, no float).
+// All arithmetic in double precision, no fast-math: the same bits on every
+// worker.
 #pragma once
 
 #include <glm/vec2.hpp>

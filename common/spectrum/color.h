@@ -1,5 +1,5 @@
 // Colour: spectral radiance → CIE 1931 XYZ (absolute, Y in cd/m²) → linear
-// Rec.709/sRGB (D65) → sRGB-encoded values (DESIGN.md §3.3).
+// Rec.709/sRGB (D65) → sRGB-encoded values.
 //
 // Convention.  X, Y, Z = K_m ∫ (x̄, ȳ, z̄)(λ) L(λ) dλ with L the spectral
 // radiance in W m⁻² sr⁻¹ nm⁻¹ and K_m = 683 lm/W (kMaxLuminousEfficacy): Y is

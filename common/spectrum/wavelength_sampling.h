@@ -1,6 +1,6 @@
 // Wavelength sampling for spectral transport: several wavelengths per path
 // (hero-wavelength sampling), stratified inside the requested wavelength range
-// or batch (DESIGN.md §3.3).
+// or batch.
 //
 // The estimator.  A spectral quantity's integral over [min, max], e.g. a
 // tristimulus value X = ∫ x̄(λ) L(λ) dλ, is estimated from one path's
@@ -14,9 +14,9 @@
 // makes the four terms negatively correlated (stratified), which lowers the
 // variance.  Wilkie, Nawaz, Droske, Weidlich, Hanika (2014), "Hero Wavelength
 // Spectral Sampling", EGSR; pbrt-v4 SampledWavelengths::SampleVisible and
-// SampledSpectrum::ToXYZ (render-core notes §1.1).
+// SampledSpectrum::ToXYZ.
 //
-// Batches.  The farm splits [min, max] into B equal batches (DESIGN.md §4); a
+// Batches.  The farm splits [min, max] into B equal batches; a
 // unit of work samples its wavelengths over its batch [batch_edge(b),
 // batch_edge(b + 1)] only, with the batch's own pdf.  Since ∫_min^max f =
 // Σ_b ∫_batch_b f, the full-spectrum estimate is the SUM over batches of the
@@ -28,7 +28,7 @@ namespace skyfarm {
 
 inline constexpr int kWavelengthsPerPath = 4;
 
-// Default spectral range of a render, nm (DESIGN.md §3.3; the CIE 1931 table).
+// Default spectral range of a render, nm (the CIE 1931 table).
 inline constexpr double kDefaultMinWavelength_nm = 360.0;
 inline constexpr double kDefaultMaxWavelength_nm = 830.0;
 

@@ -1,4 +1,4 @@
-// The sun as a light source (DESIGN §3.2):
+// The sun as a light source:
 //   direction        from the solar position algorithm for the request's place
 //                    and time, or the request's zenith / azimuth
 //   angular_radius   of the disk, 0.2666 deg by default; 0 = a point (delta) sun

@@ -1,4 +1,4 @@
-// Where the observer is and how the sun is given (DESIGN §5.1 "location",
+// Where the observer is and how the sun is given (the request's "location",
 // "time", "sun").  Plain data, validated by api/.
 #pragma once
 #include <optional>

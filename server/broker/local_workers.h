@@ -1,4 +1,4 @@
-// The embedded default (DESIGN §4): skyfarm-server starts N local
+// The embedded default: skyfarm-server starts N local
 // skyfarm-worker processes connected to its broker and keeps them running —
 // a worker that exits unexpectedly is started again (after 1 s, doubling to
 // 30 s while it keeps failing).  stop() sends SIGTERM (workers drain their

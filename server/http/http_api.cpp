@@ -464,7 +464,7 @@ void HttpApi::workers(const Request&, Response& res) { send_json(res, 200, {{"wo
 
 void HttpApi::sky(const Request& req, Response& res) { sky_->lookup(req, res); }
 
-// POST /v1/sky/radiance: the probe of DESIGN §5.2.  "lut" is answered here
+// POST /v1/sky/radiance: the radiance probe.  "lut" is answered here
 // from one-bin tables per wavelength (bounded: one table build each); "path"
 // is traced on the farm and waited for (server/probes/http_probe.h).
 void HttpApi::sky_radiance(const Request& req, Response& res, const ContentReader& reader) {

@@ -1,4 +1,4 @@
-// The HTTP API of the render farm (DESIGN §5), on cpp-httplib 0.11.
+// The HTTP API of the render farm, on cpp-httplib 0.11.
 //
 // Routes (JSON in and out unless noted; the OpenAPI document
 // api/openapi.yaml, served at /v1/openapi.yaml, is the reference):
@@ -7,7 +7,7 @@
 //                                       {"id", "state", "links", "from_cache", "created"}
 //   GET    /v1/renders?offset=&limit=   newest first, limit 1..100 (default 20)
 //                                       -> {"renders", "offset", "limit", "total"}
-//   GET    /v1/renders/{id}             the status document (DESIGN §5.3)
+//   GET    /v1/renders/{id}             the status document
 //   DELETE /v1/renders/{id}             cancel -> 202 + the status document
 //   GET    /v1/renders/{id}/image.exr   current (progressive) or final image; strong ETag,
 //   GET    /v1/renders/{id}/image.png   If-None-Match -> 304; 409 before the first pass
@@ -16,7 +16,7 @@
 //   GET    /v1/sky?...                  radiance in one direction from a cached LUT sky (JSON);
 //   GET    /v1/sky/envmap.exr?...       a cached lat-long environment map; both with strong
 //                                       ETags, If-None-Match -> 304 (server/sky/http_sky.h)
-//   POST   /v1/sky/radiance             the radiance probe (DESIGN §5.2): "lut" from tables in
+//   POST   /v1/sky/radiance             the radiance probe: "lut" from tables in
 //                                       this process, "path" traced on the farm and waited for
 //                                       (server/probes/http_probe.h: 502, 503, 504)
 //   GET    /v1/openapi.yaml             the OpenAPI 3.0 document (application/yaml)

@@ -1,4 +1,4 @@
-// The web page (issue 7): server/http/web/index.html, app.js and style.css,
+// The web page: server/http/web/index.html, app.js and style.css,
 // embedded into the binary at build time (cmake/EmbedData.cmake
 // skyfarm_embed_files) and served as
 //

@@ -1,4 +1,4 @@
-// POST /v1/sky/radiance with "method": "path" (DESIGN §5.2, issue 6): the
+// POST /v1/sky/radiance with "method": "path": the
 // probe traced on the farm (server/probes/probe_service.h); the request waits for
 // the answer.
 //

@@ -1,5 +1,5 @@
 // Path-traced radiance probes through the farm (POST /v1/sky/radiance with
-// "method": "path"; DESIGN §5.2, issue 6): a probe is cut into units
+// "method": "path"): a probe is cut into units
 // (probe_plan, common/render/probe_answer.h), the units go to the
 // workers through the ZeroMQ broker next to render units (ProbeRouter,
 // probe_router.h, asks this service first), and their sums are reduced here

@@ -1,4 +1,4 @@
-// The cached sky look-ups of the HTTP API (DESIGN §5.5, issue 6 §3):
+// The cached sky look-ups of the HTTP API:
 //
 //   GET /v1/sky              radiance in one direction (JSON)
 //   GET /v1/sky/envmap.exr   a lat-long environment map (OpenEXR)

@@ -1,5 +1,5 @@
-// The sky look-up service behind GET /v1/sky and GET /v1/sky/envmap.exr
-// (issue 6 §3): built LUT skies (common/lut/lut_sky.h) kept in memory, and
+// The sky look-up service behind GET /v1/sky and GET /v1/sky/envmap.exr:
+// built LUT skies (common/lut/lut_sky.h) kept in memory, and
 // the environment maps made from them.
 //
 // Two caches, both LRU, both bounded in BYTES, both thread-safe:
@@ -12,8 +12,9 @@
 //            caller's text); size: the EXR's bytes; default bound 128 MiB
 // A table for a new sun (or observer altitude) of an atmosphere whose tables
 // are alive (cached, or in use) is made by LutSky::with_sun from them: only
-// the sun-dependent sky-view and aerial-perspective tables are built (~27 ms
-// instead of ~165 ms at 32 bins), and every look-up equals a full build's
+// the sun-dependent sky-view and aerial-perspective tables are built (3.7-5x
+// less CPU than a full build in scripts/bench-sky.sh's cold sweep, whose
+// figures are in the README), and every look-up equals a full build's
 // bit for bit (the same code builds the same tables).  Such tables share the
 // atmosphere's tables; each entry still counts them in its bytes, so the
 // bound is an upper bound on the memory held (reached later than it could

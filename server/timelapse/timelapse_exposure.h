@@ -1,5 +1,5 @@
 // One exposure for a timelapse's frames that does not pump from frame to
-// frame (issue 7): the automatic EV100 of each frame (png_writer.h
+// frame: the automatic EV100 of each frame (png_writer.h
 // auto_exposure_ev: the median luminance of its lit pixels) smoothed in time.
 //
 // Parameters

@@ -1,4 +1,4 @@
-// The timelapse routes of the HTTP API (DESIGN §5.4, issue 7), registered by
+// The timelapse routes of the HTTP API, registered by
 // HttpApi when it has a TimelapseService (HttpOptions::timelapses):
 //
 //   POST   /v1/timelapses                     a timelapse request (api/timelapse_request.h)

@@ -1,4 +1,4 @@
-// Timelapses (DESIGN §5.4, issue 7): many frames of one camera over a time
+// Timelapses: many frames of one camera over a time
 // range, rendered as ordinary render jobs of the JobService (each frame has
 // its render id and shows under /v1/renders too), then a contact sheet and a
 // video made once, when the last frame is done.

@@ -1,4 +1,4 @@
-// Tests of the radiance probe request (DESIGN §5.2): api/examples/probe*.json,
+// Tests of the radiance probe request: api/examples/probe*.json,
 // the probe_*.json bad requests with their expected first error, defaults,
 // the fields it shares with the render request, and its canonical form.
 #include "api/probe_request.h"

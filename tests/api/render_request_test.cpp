@@ -1,4 +1,4 @@
-// Tests of the render request (DESIGN §5.1): the examples in api/examples/, the
+// Tests of the render request: the examples in api/examples/, the
 // bad requests in api/examples/bad/ with their expected first error, defaults,
 // error collection, hostile bodies and the canonical form.
 #include "api/render_request.h"

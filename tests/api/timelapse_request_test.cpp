@@ -1,4 +1,4 @@
-// Tests of the timelapse request (DESIGN §5.4, issue 7): frame times from
+// Tests of the timelapse request: frame times from
 // step_s or frames in start's offset, seeds, errors that name the field like
 // render requests do, the frame cap, and the canonical form.
 #include "api/timelapse_request.h"

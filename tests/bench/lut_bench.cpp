@@ -14,8 +14,8 @@
 //                             distance), per sun position and overall
 //
 // Scene: Earth preset (air, ozone 300 DU, aerosols), AM0 sun, observer on the
-// ground, 360-830 nm.  Issue 6's figures are BM_LutBuildAll/32, BM_LutBuildPerSun/32
-// and BM_LutRadiance/32 (docs/physics.md "The LUT sky's build time").
+// ground, 360-830 nm.  The figures quoted for the LUT sky are BM_LutBuildAll/32,
+// BM_LutBuildPerSun/32 and BM_LutRadiance/32 (docs/experiments/*-lut-build-time.md).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The render farm end to end on loopback (issue 4 §8): a real skyfarm-server,
+// The render farm end to end on loopback: a real skyfarm-server,
 // real skyfarm-worker processes, HTTP from a client.  Every test is bounded
 // in time.  The final EXR must be byte-identical to `skyfarm-worker render`
 // of the same request, whatever happened on the way.

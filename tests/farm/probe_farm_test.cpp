@@ -1,5 +1,5 @@
-// POST /v1/sky/radiance with the path tracer through the real farm (issue 6
-// §1): a real skyfarm-server, its local workers or external skyfarm-worker
+// POST /v1/sky/radiance with the path tracer through the real farm: a real
+// skyfarm-server, its local workers or external skyfarm-worker
 // processes, HTTP from a client.  The answer is byte for byte the compact
 // JSON of `skyfarm-worker probe` of the same body, whatever the number of
 // workers and when one is killed; no worker -> 503; too slow -> 504 and the

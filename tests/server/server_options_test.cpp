@@ -1,4 +1,4 @@
-// skyfarm-server's flags (DESIGN §4.1, a contract) and their environment variables.
+// skyfarm-server's flags (a contract) and their environment variables.
 #include "server/server_options.h"
 
 #include <gtest/gtest.h>

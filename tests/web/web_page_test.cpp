@@ -1,4 +1,4 @@
-// The web page in headless Chromium (issue 7): a real skyfarm-server with one
+// The web page in headless Chromium: a real skyfarm-server with one
 // local worker on loopback, chromedriver driven over WebDriver
 // (tests/support/webdriver.h).  The page is used like a person would: an
 // invalid latitude is refused by the server and the page shows the problem

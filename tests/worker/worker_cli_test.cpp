@@ -1,5 +1,5 @@
 // skyfarm-worker as a user runs it: render to EXR and PNG, probe to JSON,
-// clear errors for bad input (issue 3 §5).
+// clear errors for bad input.
 #include <gtest/gtest.h>
 
 #include <cstdio>

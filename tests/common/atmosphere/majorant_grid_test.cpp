@@ -1,4 +1,4 @@
-// Majorants bound the extinction everywhere they claim to (issue 2), and are
+// Majorants bound the extinction everywhere they claim to, and are
 // tight enough to be useful.
 #include "common/atmosphere/majorant_grid.h"
 

@@ -49,7 +49,7 @@ TEST(Ozone, AfglColumnIs345DobsonUnits) {
 }
 
 TEST(Ozone, ScaledProfileHoldsTheRequestedColumn) {
-  // The check: 300 DU +- 0.1 %, integrated independently by quadrature
+  // 300 DU +- 0.1 %, integrated independently by quadrature
   // of the profile's values (not by the table integral used for scaling).
   for (double top : {100000.0, 60000.0}) {
     const auto n = ozone::scaled_profile(300.0, top);

@@ -1,4 +1,4 @@
-// Ray / sphere intersection exactness at planetary scale (issue 2: a camera
+// Ray / sphere intersection exactness at planetary scale (a camera
 // 1 m above a 6 371 km planet exact to millimetres; grazing rays must not flip
 // between hit and miss).  Expected values are closed-form distances computed
 // from the altitude, not from |o|^2 - R^2.

@@ -51,8 +51,8 @@ TEST(LutTransmittance, MatchesQuadratureOnRandomAndGrazingRays) {
 // rays' second parts, fewer intervals on thin rows) against the plain rule
 // on 2048 intervals per part, every 4th node of each axis: at most 0.8 of
 // the tolerance max(0.5 % T, 1e-4) (measured on every node at 32 bins 0.70,
-// the same as with 64 intervals on every part; docs/physics.md "Below
-// 20 ms").  The nodes sit at v = k / (n - 1), x_mu = 1 - (1 - v)^4
+// the same as with 64 intervals on every part; docs/experiments/
+// 2026-12-02-lut-build-time.md, "Below 20 ms").  The nodes sit at v = k / (n - 1), x_mu = 1 - (1 - v)^4
 // (transmittance_lut.h).
 TEST(LutTransmittance, NodesMatchAFineQuadrature) {
   const Atmosphere atm = build_atmosphere(AtmosphereSpec{});

@@ -1,4 +1,4 @@
-// Determinism (issue 3 §2): every random number is a pure function of (seed,
+// Determinism: every random number is a pure function of (seed,
 // pixel, sample, dimension), so a tile rendered twice, or its units rendered
 // one by one in any order and merged in the plan's order, or an image rendered
 // with any number of threads, gives bit-identical sums.

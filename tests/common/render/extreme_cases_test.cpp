@@ -1,4 +1,4 @@
-// Stiff and extreme cases (DESIGN §3.6, issue 5 §4).  Each case says why it
+// Stiff and extreme cases.  Each case says why it
 // is hard.  Every result must be finite and >= 0, with no path rejected by the
 // NaN/Inf firewall and none cut by the depth cap.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Physics validation of the path tracer against closed forms (issue 3 §6).
+// Physics validation of the path tracer against closed forms.
 // Statistical tests use fixed seeds; tolerances are 4 standard errors of the
 // Monte Carlo estimate plus, where stated, a modelling allowance.
 #include <gtest/gtest.h>
@@ -269,7 +269,7 @@ TEST(IntegratorPhysics, ShadowGuideKeepsTheMean) {
 // alive longer (more collisions per path: the paths it used to kill carried
 // the light from the lit air), and never applies by day: the same values,
 // bit for bit.  Its effect on the error is measured in bench convergence
-// (docs/physics.md, "Efficiency"), not here: a twilight path's relative std
+// (docs/experiments/2026-11-22-path-tracer-variance.md), not here: a twilight path's relative std
 // is about 7, so a sample variance is too noisy for an assertion.
 TEST(IntegratorPhysics, ShadowRouletteThresholdKeepsTheMeanAndLeavesDaylightAlone) {
   IntegratorOptions low, one;
@@ -362,7 +362,7 @@ TEST(IntegratorPhysics, RouletteControlKeepsTheMeanWithLessNoise) {
 // --- White furnace: a non-absorbing atmosphere over a white ground under a
 // uniform sky light L_env (no sun) has radiance L_env everywhere, from any
 // viewpoint, whatever the density profiles and phase functions (energy
-// conservation; render-core notes §5.3 item 3).
+// conservation).
 TEST(IntegratorPhysics, WhiteFurnaceReturnsTheEnvironmentRadiance) {
   AtmosphereSpec spec;
   spec.preset = AtmospherePreset::kCustom;

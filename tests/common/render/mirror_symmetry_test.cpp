@@ -1,4 +1,4 @@
-// Mirror symmetry (DESIGN §3.5, issue 5 §6): an equirectangular view centred
+// Mirror symmetry: an equirectangular view centred
 // on the sun's vertical plane renders its left half and mirrors it.
 #include <gtest/gtest.h>
 

@@ -23,8 +23,8 @@ RenderPlan plan_of(double zenith_deg, bool lut = false) {
 TEST(RenderPlanFor, RouletteControlOnlyForPathTracedSkiesWithAHighSun) {
   EXPECT_TRUE(plan_of(30.0).roulette_control);
   EXPECT_TRUE(plan_of(85.0).roulette_control);
-  // A sun at the horizon or below: it no longer pays (docs/physics.md,
-  // "Roulette with a control variate").
+  // A sun at the horizon or below: it no longer pays
+  // (docs/experiments/2026-11-22-path-tracer-variance.md).
   EXPECT_FALSE(plan_of(90.0).roulette_control);
   EXPECT_FALSE(plan_of(96.0).roulette_control);
   // The LUT renderer traces no paths.

@@ -1,4 +1,4 @@
-// The stability matrix (issue 3 §6; DESIGN §3.6): sun zenith 0 ... 108 deg x
+// The stability matrix: sun zenith 0 ... 108 deg x
 // camera at 0 m ... geostationary orbit, equirectangular views: every pixel
 // finite and >= 0, no path rejected by the NaN/Inf firewall, none cut by the
 // depth cap; and at sun zenith 96 deg the sky towards the sun is dim but not

@@ -26,7 +26,7 @@ TEST(UtcTime, UnixEpochIsZero) {
 }
 
 TEST(UtcTime, OffsetsConvertToTheSameInstant) {
-  // DESIGN §5.1 example: 09:30 at UTC-4 is 13:30 UTC.
+  // 09:30 at UTC-4 is 13:30 UTC.
   const auto utc = parse_ok("2013-05-27T13:30:00Z");
   EXPECT_EQ(parse_ok("2013-05-27T09:30:00-04:00").unix_seconds, utc.unix_seconds);
   EXPECT_EQ(parse_ok("2013-05-27T09:30:00-0400").unix_seconds, utc.unix_seconds);

@@ -371,7 +371,7 @@ TEST(JobService, HigherPriorityJobsGoFirst) {
 namespace skyfarm::server {
 namespace {
 
-// Quality modes (DESIGN §6): a target error stops the job at the first whole
+// Quality modes: a target error stops the job at the first whole
 // pass whose estimate meets it, with the same bytes as a local render that
 // stops by the same rule, whatever order the results arrive in.
 TEST(JobService, TargetErrorStopsAtAWholePassWithLocalBytes) {

@@ -416,7 +416,7 @@ TEST(SkyQuery, DefaultsAndCanonicalForm) {
   EXPECT_NEAR(tokyo.table.sun_zenith_deg, 76.2, 0.5);
 }
 
-// POST /v1/sky/radiance (DESIGN §5.2): the probe by the LUT (no standard
+// POST /v1/sky/radiance: the probe by the LUT (no standard
 // error, in the server) and by the path tracer on the farm (with standard
 // errors; here two in-process workers), agreeing at the zenith; the farm's
 // answer is the local probe's document byte for byte; bad bodies and probes

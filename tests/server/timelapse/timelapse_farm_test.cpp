@@ -1,4 +1,4 @@
-// Timelapses end to end on loopback (issue 7): a real skyfarm-server with its
+// Timelapses end to end on loopback: a real skyfarm-server with its
 // local ZeroMQ workers, HTTP from a client.  A 4-frame timelapse finishes with
 // its frames in time order, a contact sheet of the documented size and a
 // video (when ffmpeg is installed); a bogus ffmpeg leaves only the video out;
