@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 
@@ -70,7 +71,12 @@ double erfinv(double v) {
 }  // namespace
 
 MicrofacetDistribution::MicrofacetDistribution(MicrofacetModel model, double alpha_x, double alpha_y)
-    : model_(model), alpha_x_(alpha_x), alpha_y_(alpha_y) {}
+    : model_(model), alpha_x_(alpha_x), alpha_y_(alpha_y) {
+  // D divides by alpha_x alpha_y: a zero or non-finite roughness has no
+  // distribution (a perfect mirror is a separate, delta, component).
+  if (!(alpha_x > 0.0 && alpha_y > 0.0 && std::isfinite(alpha_x) && std::isfinite(alpha_y)))
+    throw std::invalid_argument("MicrofacetDistribution: alpha_x and alpha_y must be finite and > 0");
+}
 
 double MicrofacetDistribution::D(const glm::dvec3& wm) const {
   if (wm.z <= 0.0) return 0.0;
@@ -182,7 +188,9 @@ glm::dvec3 MicrofacetDistribution::sample_visible_normal_beckmann(const glm::dve
   double slope_x;
   if (sin_theta == 0.0 || std::abs(ws.z / sin_theta) > 26.0) {
     // At (near) normal incidence from above the truncation is beyond
-    // double precision: the slope is plain Gaussian.
+    // double precision: the slope is plain Gaussian.  From (near) straight
+    // below, only slopes steeper than 26 face wo and their density
+    // underflows: the steepest representable slope stands in for them.
     slope_x = ws.z > 0.0 ? erfinv(2.0 * u.x - 1.0) : -26.0;
   } else {
     const double a = ws.z / sin_theta;

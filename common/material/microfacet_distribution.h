@@ -13,7 +13,8 @@
 //             Beckmann; the GGX width).  Values from 1e-4 (near mirror) to 2
 //             (very rough) are exercised by the tests; alpha_x == alpha_y is
 //             the isotropic case.
-//   alpha_y   roughness along y, > 0.
+//   alpha_y   roughness along y, > 0.  The constructor throws
+//             std::invalid_argument for a zero, negative or non-finite alpha.
 //   wm        microfacet normal.  D(wm) is 0 for wm.z <= 0 (the surface is a
 //             height field: no normal points below the macro surface).
 //   w, wo     a direction of view or light.  lambda() and g1() are Smith's

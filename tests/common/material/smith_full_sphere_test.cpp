@@ -72,7 +72,9 @@ TEST(SmithFullSphere, G1MatchesProjectedAreaIntegralAboveAndBelow) {
           const double numeric = std::abs(w.z) / facing_area(dist, w);
           const double g1 = g1_full_sphere(dist, w);
           EXPECT_NEAR(g1, numeric, 1e-3 * numeric);
-          if (w.z > 0.0) EXPECT_DOUBLE_EQ(g1, dist.g1(w));
+          if (w.z > 0.0) {
+            EXPECT_DOUBLE_EQ(g1, dist.g1(w));
+          }
         }
       }
     }
@@ -114,7 +116,9 @@ TEST(SmithFullSphere, G2MatchesProjectedAreaIntegral) {
           EXPECT_DOUBLE_EQ(g2_full_sphere(dist, wo, wi), g2);
           EXPECT_LE(g2, g1_full_sphere(dist, wi) * (1.0 + 1e-12));
           // Both above: heights correlate the two visibilities positively.
-          if (wi.z > 0.0) EXPECT_GE(g2, dist.g1(wi) * dist.g1(wo));
+          if (wi.z > 0.0) {
+            EXPECT_GE(g2, dist.g1(wi) * dist.g1(wo));
+          }
         }
       }
     }
