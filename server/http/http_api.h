@@ -64,13 +64,7 @@
 #include "server/http/http_backend.h"
 #include "server/probes/probe_service.h"
 #include "server/sky/sky_service.h"
-
-namespace httplib {
-class Server;
-class ContentReader;
-struct Request;
-struct Response;
-}  // namespace httplib
+#include "server/http/httplib_fwd.h"
 
 namespace skyfarm::server {
 

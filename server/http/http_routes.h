@@ -12,13 +12,7 @@
 #include <string>
 #include <string_view>
 #include <vector>
-
-namespace httplib {
-class Server;
-class ContentReader;
-struct Request;
-struct Response;
-}  // namespace httplib
+#include "server/http/httplib_fwd.h"
 
 namespace skyfarm::server {
 

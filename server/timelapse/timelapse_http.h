@@ -27,13 +27,7 @@
 #include <string_view>
 
 #include "server/timelapse/timelapse_service.h"
-
-namespace httplib {
-class Server;
-class ContentReader;
-struct Request;
-struct Response;
-}  // namespace httplib
+#include "server/http/httplib_fwd.h"
 
 namespace skyfarm::server {
 
