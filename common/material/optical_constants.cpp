@@ -144,15 +144,21 @@ SellmeierDispersion SellmeierDispersion::parse_coefficients(std::string_view tex
     if (it == values.end()) throw std::runtime_error(source + ": missing coefficient `" + key + "`");
     return it->second;
   };
+  // Coefficient names: `prefix` + the term's number + `suffix` ("C2_um2").
+  const auto name = [](std::string_view prefix, int i, std::string_view suffix) {
+    std::string out(prefix);
+    out += std::to_string(i);
+    out += suffix;
+    return out;
+  };
   std::vector<SellmeierTerm> terms;
-  for (int i = 1; values.contains("B" + std::to_string(i)); ++i) {
-    const std::string idx = std::to_string(i);
+  for (int i = 1; values.contains(name("B", i, "")); ++i) {
     SellmeierTerm t;
-    t.b = get("B" + idx);
-    if (values.contains("C" + idx + "_um2")) {
-      t.c_um2 = get("C" + idx + "_um2");
+    t.b = get(name("B", i, ""));
+    if (values.contains(name("C", i, "_um2"))) {
+      t.c_um2 = get(name("C", i, "_um2"));
     } else {
-      const double lambda_um = get("lambda" + idx + "_um");  // Malitson's resonance wavelengths
+      const double lambda_um = get(name("lambda", i, "_um"));  // Malitson's resonance wavelengths
       t.c_um2 = lambda_um * lambda_um;
     }
     terms.push_back(t);
