@@ -29,6 +29,9 @@ TEST(CsvTable, MalformedCellNamesSourceLineAndColumn) {
 
 TEST(CsvTable, EveryEmbeddedTableParses) {
   for (const auto& name : embedded_file_names()) {
+    // The Sellmeier coefficient files are `coefficient,value` rows, read by
+    // name (tests/common/material/optical_constants_test.cpp parses them).
+    if (embedded_file(name).starts_with("coefficient,value\n")) continue;
     const auto t = CsvTable::embedded(name);
     EXPECT_GT(t.rows(), 5u) << name;
   }

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
@@ -70,6 +71,21 @@ TEST(Sellmeier, WaterDaimonMasumura) {
   ASSERT_EQ(water.terms().size(), 4u);
   EXPECT_NEAR(water.n(589.0), 1.333, 1e-3);
   EXPECT_NEAR(water.n(589.0), 1.33336, 2e-5);
+}
+
+// The embedded files in `coefficient,value` form are exactly the three
+// Sellmeier fits, and each parses (the numeric-table check skips them).
+TEST(Sellmeier, EveryEmbeddedCoefficientFileParses) {
+  std::vector<std::string> found;
+  for (const std::string& name : embedded_file_names()) {
+    if (!embedded_file(name).starts_with("coefficient,value\n")) continue;
+    found.push_back(name);
+    EXPECT_NO_THROW(embedded_sellmeier(name)) << name;
+  }
+  std::sort(found.begin(), found.end());
+  EXPECT_EQ(found, (std::vector<std::string>{"fused_silica_sellmeier_malitson1965.csv",
+                                             "glass_n_bk7_sellmeier_schott.csv",
+                                             "water_sellmeier_daimon_masumura2007_20C.csv"}));
 }
 
 // B = 1, C = 0: n² = 1 + 1 at every wavelength.
