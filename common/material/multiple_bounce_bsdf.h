@@ -12,7 +12,8 @@
 //                 surface with heights) or ::uncorrelated (reciprocal).
 //   cosine_share  the probability, in [0, 1), with which sample() proposes a
 //                 cosine-weighted direction instead of the single-bounce
-//                 lobe (default 0.3): the multiple-bounce lobe is broad.
+//                 lobe (default 0.5): the multiple-bounce lobe is broad,
+//                 and a sharper proposal gains little while f is noisy.
 //
 // f() is stochastic: one walk from wi with connections to wo (the
 // unidirectional estimator), divided by |wo.z|; the value is in the radiance
@@ -32,7 +33,7 @@ namespace skyfarm::material {
 class MultipleBounceBsdf final : public Bsdf {
  public:
   MultipleBounceBsdf(const MicrofacetDistribution& distribution, Facet facet,
-                     HeightCorrelation correlation = HeightCorrelation::correlated, double cosine_share = 0.3);
+                     HeightCorrelation correlation = HeightCorrelation::correlated, double cosine_share = 0.5);
 
   std::uint32_t flags() const override;
   bool stochastic() const override { return true; }
