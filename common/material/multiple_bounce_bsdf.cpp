@@ -41,7 +41,7 @@ std::uint32_t MultipleBounceBsdf::flags() const {
 
 double MultipleBounceBsdf::f(const glm::dvec3& wo, const glm::dvec3& wi, RandomSequence& rng) const {
   if (wo.z == 0.0) return 0.0;
-  const double value = walk_.estimate(wi, wo, rng) / std::abs(wo.z);
+  const double value = walk_.estimate_bidirectional(wi, wo, rng) / std::abs(wo.z);
   return std::isfinite(value) ? value : 0.0;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -170,6 +171,142 @@ std::optional<PositionFreeWalk::Exit> PositionFreeWalk::trace(const glm::dvec3& 
     v = -s->w;
   }
   return std::nullopt;
+}
+
+}  // namespace skyfarm::material
+
+namespace skyfarm::material {
+
+// The bidirectional estimator for mirror / conductor facets.  A path of k
+// bounces has directions v_i (towards the previous bounce; v_1 = wi) and t_i
+// (towards the next; t_k = wo, v_{i+1} = -t_i), and contribution
+//   prod_{i<k} phi(v_i, t_i) c(v_i, t_i)  x  phi(v_k, wo) L(v_k, wo),
+// phi(v, t) = F(v.wh) D_v(wh) / (4 v.wh) the mirror vertex term (wh the half
+// vector), c and L the continue and leave probabilities (leave_probability).
+// Forward sampling draws t_i with density pf_i = D_{v_i}(wh) / (4 v_i.wh)
+// and continues with probability c: weight F per bounce.  Reverse sampling
+// (from wo) draws v_i given t_i with density pr_i = D_{t_i}(wh) / (4 t_i.wh)
+// and continues with probability r, its own leave test: weight
+//   phi(v_i, t_i) / pr_i x (c or L) / r = F G1(v_i) |t_i.z| / (G1(t_i) |v_i.z|) x (c or L) / r.
+// Joining a forward prefix of a draws to a reverse prefix of b draws at
+// vertex j = a + 1 gives a path of k = a + b + 1 bounces; its balance
+// weight is P_j / sum_l P_l with P_l = prod_{i<l} pf_i c_i prod_{i>l} pr_i r_i,
+// the whole densities of the draws, continuation tests included (left out,
+// a reverse draw that nearly always leaves would get a large weight 1 / r).
+double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo,
+                                                RandomSequence& rng) const {
+  if (facet_.kind != FacetKind::conductor) return estimate(wi, wo, rng);
+  if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+  const int cap = std::min(max_bounces_, 64);
+
+  // Forward: forward_v[a] is v_{a+1}; forward_weight[a] the throughput of a draws.
+  std::vector<glm::dvec3> forward_v{wi};
+  std::vector<double> forward_weight{1.0};
+  while (static_cast<int>(forward_v.size()) < cap) {
+    const glm::dvec3 v = forward_v.back();
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    const double cos_vm = glm::dot(v, wm);
+    if (!(cos_vm > 0.0)) break;
+    const glm::dvec3 t = reflect_about(v, wm);
+    const double weight = forward_weight.back() * facet_.fresnel.reflectance(cos_vm);
+    if (!(weight > 0.0)) break;
+    const double leave = leave_probability(v, t);
+    if (leave > 0.0 && rng.next() < leave) break;
+    forward_v.push_back(-t);
+    forward_weight.push_back(weight);
+  }
+
+  // Reverse: reverse_t[b] is the outgoing direction of the joining vertex
+  // after b draws (reverse_t[0] = wo); reverse_weight[b] the throughput.
+  std::vector<glm::dvec3> reverse_t{wo};
+  std::vector<double> reverse_weight{1.0};
+  while (static_cast<int>(reverse_t.size()) < cap) {
+    const glm::dvec3 t = reverse_t.back();
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(t, {u0, u1});
+    const double cos_tm = glm::dot(t, wm);
+    if (!(cos_tm > 0.0)) break;
+    const glm::dvec3 v = reflect_about(t, wm);
+    if (v.z == 0.0) break;
+    const double segment = reverse_t.size() == 1 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+    const double carry = 1.0 - leave_probability(t, v);
+    const double ratio = facet_.fresnel.reflectance(cos_tm) * g1_full_sphere(distribution_, v) * std::abs(t.z) /
+                         (g1_full_sphere(distribution_, t) * std::abs(v.z));
+    const double weight = reverse_weight.back() * ratio * segment / carry;
+    if (!(carry > 0.0) || !(weight > 0.0) || !std::isfinite(weight)) break;
+    if (rng.next() >= carry) break;
+    reverse_t.push_back(-v);
+    reverse_weight.push_back(weight);
+  }
+
+  // The forward and reverse densities of one bounce (v, t), each times the
+  // probability that its walk goes on after it.
+  auto densities = [&](const glm::dvec3& v, const glm::dvec3& t, double* pf, double* pr) {
+    const glm::dvec3 sum = v + t;
+    const double length = glm::length(sum);
+    *pf = 0.0;
+    *pr = 0.0;
+    if (!(length > 0.0)) return;
+    const glm::dvec3 wh = sum / length;
+    const double cos_v = glm::dot(v, wh);
+    const double cos_t = glm::dot(t, wh);
+    if (cos_v <= 0.0 || cos_t <= 0.0) return;
+    *pf = distribution_.visible_normal_pdf(v, wh) / (4.0 * cos_v) * (1.0 - leave_probability(v, t));
+    *pr = distribution_.visible_normal_pdf(t, wh) / (4.0 * cos_t) * (1.0 - leave_probability(t, v));
+  };
+
+  std::vector<double> pf;
+  std::vector<double> pr;
+  double total = 0.0;
+  for (std::size_t a = 0; a < forward_v.size(); ++a) {
+    for (std::size_t b = 0; b < reverse_t.size(); ++b) {
+      const glm::dvec3& v = forward_v[a];
+      const glm::dvec3& t = reverse_t[b];
+      const double phi = scatter_density(v, v, true, t, 1.0);  // mirror: wm unused
+      if (!(phi > 0.0)) continue;
+      const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+      const double contribution = forward_weight[a] * phi * segment * reverse_weight[b];
+      if (!(contribution > 0.0)) continue;
+      // The path's bounces 1..k: forward draws, the joining bounce, reverse draws.
+      const std::size_t k = a + b + 1;
+      pf.assign(k, 0.0);
+      pr.assign(k, 0.0);
+      for (std::size_t i = 0; i < k; ++i) {
+        glm::dvec3 vi;
+        glm::dvec3 ti;
+        if (i < a) {
+          vi = forward_v[i];
+          ti = -forward_v[i + 1];
+        } else if (i == a) {
+          vi = v;
+          ti = t;
+        } else {
+          const std::size_t m = k - i;  // reverse draws that reach bounce i + 1
+          vi = -reverse_t[m];
+          ti = reverse_t[m - 1];
+        }
+        densities(vi, ti, &pf[i], &pr[i]);
+      }
+      // sum_l P_l / P_j, stepping away from j = a on both sides.
+      double sum = 1.0;
+      double ratio = 1.0;
+      for (std::size_t l = a + 1; l < k; ++l) {
+        ratio *= pf[l - 1] / pr[l];
+        sum += ratio;
+      }
+      ratio = 1.0;
+      for (std::size_t l = a; l-- > 0;) {
+        ratio *= pr[l + 1] / pf[l];
+        sum += ratio;
+      }
+      const double weight = 1.0 / sum;
+      if (std::isfinite(weight)) total += weight * contribution;
+    }
+  }
+  return std::isfinite(total) ? total : 0.0;
 }
 
 }  // namespace skyfarm::material

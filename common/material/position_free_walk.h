@@ -33,6 +33,17 @@
 //                   paper's connection of the path to the fixed last
 //                   direction); analytic for mirror and dielectric facets,
 //                   one visible normal for Lambertian facets.
+//   bidirectional   (mirror / conductor facets) a walk from the light and one
+//                   from the viewer, every prefix of one joined to every
+//                   prefix of the other at one vertex whose term is
+//                   evaluated analytically; the strategies that can make a
+//                   path of k bounces (the joining vertex 1..k) are weighted
+//                   by the balance heuristic over their direction densities.
+//                   The reverse walk's vertex terms follow from the forward
+//                   ones by D_v(wh) / (4 v.wh) = G1(v) D(wh) / (4 |v.z|).
+//                   It removes the spikes of the unidirectional connection
+//                   through a sharp facet density seen from a random
+//                   direction (smooth surfaces, several bounces).
 //
 // Parameters
 //   distribution  the microfacet distribution.
@@ -88,6 +99,11 @@ class PositionFreeWalk {
   // [min_order, max_order] are left out (1, 1 is the single-bounce BSDF).
   double estimate(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng, int min_order = 1,
                   int max_order = 1 << 30) const;
+
+  // One estimate of f(wo, wi) |wo.z| by the bidirectional estimator (both
+  // directions above the macro surface).  Only conductor facets have it;
+  // for the others this is estimate().
+  double estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
 
   // One walk from the light direction wi to its exit: the direction it leaves
   // along and the energy it carries (its density over the exit direction,
