@@ -81,8 +81,7 @@ double MultipleBounceBsdf::pdf(const glm::dvec3& wo, const glm::dvec3& wi) const
   return cosine_share_ * cosine_pdf(wo, wi) + (1.0 - cosine_share_) * lobe_pdf(wo, wi);
 }
 
-std::optional<BsdfSample> MultipleBounceBsdf::sample(const glm::dvec3& wo, double uc, const glm::dvec2& u,
-                                                     RandomSequence& rng) const {
+std::optional<glm::dvec3> MultipleBounceBsdf::propose(const glm::dvec3& wo, double uc, const glm::dvec2& u) const {
   const FacetKind kind = walk_.facet().kind;
   if (wo.z == 0.0 || (kind != FacetKind::dielectric && wo.z < 0.0)) return std::nullopt;
   glm::dvec3 wi;
@@ -96,17 +95,27 @@ std::optional<BsdfSample> MultipleBounceBsdf::sample(const glm::dvec3& wo, doubl
       const glm::dvec3 wh = walk_.distribution().sample_visible_normal(wo, u);
       wi = reflect_about(wo, wh);
     } else {
-      const std::optional<BsdfSample> s = dielectric_lobe_.sample(wo, uc_lobe, u, rng);
+      RandomSequence unused(0);  // the dielectric's proposal draws nothing more
+      const std::optional<BsdfSample> s = dielectric_lobe_.sample(wo, uc_lobe, u, unused);
       if (!s) return std::nullopt;
       wi = s->wi;
     }
   }
   if (wi.z == 0.0 || (kind != FacetKind::dielectric && wi.z < 0.0)) return std::nullopt;
+  if (!(pdf(wo, wi) > 0.0)) return std::nullopt;
+  return wi;
+}
+
+std::optional<BsdfSample> MultipleBounceBsdf::sample(const glm::dvec3& wo, double uc, const glm::dvec2& u,
+                                                     RandomSequence& rng) const {
+  const std::optional<glm::dvec3> proposed = propose(wo, uc, u);
+  if (!proposed) return std::nullopt;
+  const glm::dvec3 wi = *proposed;
   const double pdf = this->pdf(wo, wi);
-  if (!(pdf > 0.0) || !std::isfinite(pdf)) return std::nullopt;
+  if (!std::isfinite(pdf)) return std::nullopt;
   const double value = f(wo, wi, rng) * std::abs(wi.z) / pdf;
   std::uint32_t lobe = (wi.z > 0.0) == (wo.z > 0.0) ? kBsdfReflection : kBsdfTransmission;
-  lobe |= kind == FacetKind::diffuse ? kBsdfDiffuse : kBsdfGlossy;
+  lobe |= walk_.facet().kind == FacetKind::diffuse ? kBsdfDiffuse : kBsdfGlossy;
   return BsdfSample{wi, value, pdf, lobe};
 }
 

@@ -44,6 +44,11 @@ class MultipleBounceBsdf final : public Bsdf {
                                    RandomSequence& rng) const override;
   double pdf(const glm::dvec3& wo, const glm::dvec3& wi) const override;
 
+  // sample()'s proposal alone, without evaluating f: a direction drawn with
+  // density pdf(wo, .).  The path tracer proposes once with the hero
+  // wavelength's BSDF and evaluates f at every wavelength of the path.
+  std::optional<glm::dvec3> propose(const glm::dvec3& wo, double uc, const glm::dvec2& u) const;
+
   const PositionFreeWalk& walk() const { return walk_; }
 
  private:

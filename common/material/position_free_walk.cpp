@@ -258,11 +258,23 @@ double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm:
     *pr = distribution_.visible_normal_pdf(t, wh) / (4.0 * cos_t) * (1.0 - leave_probability(t, v));
   };
 
+  // The densities of the drawn bounces do not depend on where the walks are
+  // joined: forward bounce i is (forward_v[i], -forward_v[i + 1]), reverse
+  // draw m is (-reverse_t[m], reverse_t[m - 1]).
+  const std::size_t na = forward_v.size();
+  const std::size_t nb = reverse_t.size();
+  std::vector<double> forward_pf(na, 0.0);
+  std::vector<double> forward_pr(na, 0.0);
+  for (std::size_t i = 0; i + 1 < na; ++i) densities(forward_v[i], -forward_v[i + 1], &forward_pf[i], &forward_pr[i]);
+  std::vector<double> reverse_pf(nb, 0.0);
+  std::vector<double> reverse_pr(nb, 0.0);
+  for (std::size_t m = 1; m < nb; ++m) densities(-reverse_t[m], reverse_t[m - 1], &reverse_pf[m], &reverse_pr[m]);
+
   std::vector<double> pf;
   std::vector<double> pr;
   double total = 0.0;
-  for (std::size_t a = 0; a < forward_v.size(); ++a) {
-    for (std::size_t b = 0; b < reverse_t.size(); ++b) {
+  for (std::size_t a = 0; a < na; ++a) {
+    for (std::size_t b = 0; b < nb; ++b) {
       const glm::dvec3& v = forward_v[a];
       const glm::dvec3& t = reverse_t[b];
       const double phi = scatter_density(v, v, true, t, 1.0);  // mirror: wm unused
@@ -270,25 +282,19 @@ double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm:
       const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
       const double contribution = forward_weight[a] * phi * segment * reverse_weight[b];
       if (!(contribution > 0.0)) continue;
-      // The path's bounces 1..k: forward draws, the joining bounce, reverse draws.
+      // The path's bounces 0..k-1: forward draws, the joining bounce a,
+      // reverse draws (bounce i is reverse draw k - i).
       const std::size_t k = a + b + 1;
       pf.assign(k, 0.0);
       pr.assign(k, 0.0);
-      for (std::size_t i = 0; i < k; ++i) {
-        glm::dvec3 vi;
-        glm::dvec3 ti;
-        if (i < a) {
-          vi = forward_v[i];
-          ti = -forward_v[i + 1];
-        } else if (i == a) {
-          vi = v;
-          ti = t;
-        } else {
-          const std::size_t m = k - i;  // reverse draws that reach bounce i + 1
-          vi = -reverse_t[m];
-          ti = reverse_t[m - 1];
-        }
-        densities(vi, ti, &pf[i], &pr[i]);
+      for (std::size_t i = 0; i < a; ++i) {
+        pf[i] = forward_pf[i];
+        pr[i] = forward_pr[i];
+      }
+      densities(v, t, &pf[a], &pr[a]);
+      for (std::size_t i = a + 1; i < k; ++i) {
+        pf[i] = reverse_pf[k - i];
+        pr[i] = reverse_pr[k - i];
       }
       // sum_l P_l / P_j, stepping away from j = a on both sides.
       double sum = 1.0;
