@@ -15,6 +15,7 @@
 
 #include "common/material/multiple_bounce_bsdf.h"
 #include "common/material/rough_conductor.h"
+#include "common/material/rough_dielectric.h"
 #include "common/material/smith_full_sphere.h"
 #include "tests/common/material/sphere_quadrature.h"
 
@@ -151,6 +152,26 @@ TEST(BsdfWhiteFurnace, FirstOrderOfTheWalkIsTheSingleBounceBrdf) {
     const double expected = single.f(wo, wi, rng) * wo.z;
     EXPECT_NEAR(walk.estimate(wi, wo, rng, 1, 1), expected, 1e-12 * expected + 1e-300);
   }
+}
+
+// For dielectric facets too, reflection and refraction, light from either
+// side: the first order is Walter et al.'s BSDF in radiance form (light from
+// wi seen from wo), whose integral over wo is the flux kept.
+TEST(BsdfWhiteFurnace, FirstOrderOfTheDielectricWalkIsTheSingleBounceBsdf) {
+  const MicrofacetDistribution dist(MicrofacetModel::ggx, 0.5, 0.3);
+  const PositionFreeWalk walk(dist, Facet::dielectric(1.5), HeightCorrelation::correlated);
+  const RoughDielectric single(dist, 1.5, TransportMode::radiance);
+  RandomSequence rng(6);
+  int nonzero = 0;
+  for (int i = 0; i < 400; ++i) {
+    const glm::dvec3 wi = glm::normalize(glm::dvec3(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5));
+    const glm::dvec3 wo = glm::normalize(glm::dvec3(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5));
+    const double expected = single.f(wo, wi, rng) * std::abs(wo.z);
+    if (expected > 0.0) ++nonzero;
+    EXPECT_NEAR(walk.estimate(wi, wo, rng, 1, 1), expected, 1e-10 * expected + 1e-300)
+        << "wi.z " << wi.z << " wo.z " << wo.z;
+  }
+  EXPECT_GT(nonzero, 200);
 }
 
 // The walk itself conserves energy exactly: with non-absorbing facets every
