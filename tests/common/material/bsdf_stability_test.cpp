@@ -91,8 +91,9 @@ TEST(BsdfStability, RejectsInvalidParameters) {
   EXPECT_THROW(RoughDielectric(dist, 1.0), std::invalid_argument);
   EXPECT_THROW(RoughDielectric(dist, -2.0), std::invalid_argument);
   EXPECT_THROW(MultipleBounceBsdf(dist, Facet::dielectric(1.0)), std::invalid_argument);
-  EXPECT_THROW(MultipleBounceBsdf(dist, Facet::conductor(ConductorFresnel::mirror()), HeightCorrelation::correlated, 1.0),
-               std::invalid_argument);
+  EXPECT_THROW(
+      MultipleBounceBsdf(dist, Facet::conductor(ConductorFresnel::mirror()), HeightCorrelation::correlated, 1.0),
+      std::invalid_argument);
 }
 
 }  // namespace

@@ -60,7 +60,8 @@ Estimate albedo(const MultipleBounceBsdf& bsdf, const glm::dvec3& wi, int sample
 // Any BSDF's sample() as the proposal.
 Estimate albedo_by_sample(const Bsdf& bsdf, const glm::dvec3& wi, int samples, std::uint64_t seed) {
   return albedo(bsdf, wi, samples, seed,
-                [&](const glm::dvec3& w, double uc, const glm::dvec2& u, RandomSequence& rng) -> std::optional<glm::dvec3> {
+                [&](const glm::dvec3& w, double uc, const glm::dvec2& u,
+                    RandomSequence& rng) -> std::optional<glm::dvec3> {
                   const auto s = bsdf.sample(w, uc, u, rng);
                   if (!s) return std::nullopt;
                   return s->wi;
@@ -132,7 +133,8 @@ TEST(BsdfWhiteFurnace, SingleBounceLosesTheMultipleScatteringShare) {
     }
     const double mean = sum / kSamples;
     const double se = std::sqrt((sum2 / kSamples - mean * mean) / kSamples);
-    std::printf("alpha %.1f: single-bounce E1 %.5f (quadrature), %.5f +- %.5f (MC); orders >= 2 %.5f +- %.5f vs 1 - E1 %.5f\n",
+    std::printf("alpha %.1f: single-bounce E1 %.5f (quadrature), %.5f +- %.5f (MC); "
+                "orders >= 2 %.5f +- %.5f vs 1 - E1 %.5f\n",
                 alpha, e1, e.mean, e.standard_error, mean, se, 1.0 - e1);
     EXPECT_NEAR(mean, 1.0 - e1, 4.0 * se + 1e-4) << "alpha " << alpha;
   }
@@ -179,7 +181,8 @@ TEST(BsdfWhiteFurnace, FirstOrderOfTheDielectricWalkIsTheSingleBounceBsdf) {
 TEST(BsdfWhiteFurnace, EveryNonAbsorbingWalkLeavesWithAllItsEnergy) {
   for (double alpha : kAlphas) {
     const MicrofacetDistribution dist(MicrofacetModel::ggx, alpha, alpha * 0.5);
-    for (const Facet& facet : {Facet::conductor(ConductorFresnel::mirror()), Facet::diffuse(1.0), Facet::dielectric(1.5)}) {
+    for (const Facet& facet :
+         {Facet::conductor(ConductorFresnel::mirror()), Facet::diffuse(1.0), Facet::dielectric(1.5)}) {
       for (HeightCorrelation c : {HeightCorrelation::correlated, HeightCorrelation::uncorrelated}) {
         const PositionFreeWalk walk(dist, facet, c);
         RandomSequence rng(606);
