@@ -1,0 +1,318 @@
+#include "common/material/position_free_walk.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "common/material/direction_sampling.h"
+#include "common/material/fresnel.h"
+#include "common/material/smith_full_sphere.h"
+
+namespace skyfarm::material {
+
+PositionFreeWalk::PositionFreeWalk(const MicrofacetDistribution& distribution, Facet facet,
+                                   HeightCorrelation correlation, int max_bounces)
+    : distribution_(distribution), facet_(facet), correlation_(correlation), max_bounces_(max_bounces) {
+  if (max_bounces < 1) throw std::invalid_argument("PositionFreeWalk: max_bounces < 1");
+  if (facet.kind == FacetKind::dielectric && (!(facet.eta > 0.0) || !std::isfinite(facet.eta) || facet.eta == 1.0)) {
+    throw std::invalid_argument("PositionFreeWalk: dielectric eta must be finite, > 0 and != 1");
+  }
+  if (facet.kind == FacetKind::diffuse && !(facet.albedo >= 0.0 && facet.albedo <= 1.0)) {
+    throw std::invalid_argument("PositionFreeWalk: albedo outside [0, 1]");
+  }
+}
+
+// Uncorrelated: the distant masking of the leaving direction, supplement
+// eq. 3 (the complement is e = 1 - G1^dist of eq. 22).  Correlated: the
+// last-bounce term over the arrival term, eq. 13 / eq. 3; its complement is
+// eq. 17 over eq. 3.  Below the macro surface nothing leaves.
+double PositionFreeWalk::leave_probability(const glm::dvec3& v, const glm::dvec3& w) const {
+  if (w.z <= 0.0) return 0.0;
+  double p = 0.0;
+  if (correlation_ == HeightCorrelation::uncorrelated) {
+    p = g1_full_sphere(distribution_, w);
+  } else {
+    const double arrival = g1_full_sphere(distribution_, v);
+    p = std::isfinite(arrival) ? g2_full_sphere(distribution_, v, w) / arrival : 1.0;
+  }
+  return std::isfinite(p) ? std::clamp(p, 0.0, 1.0) : 0.0;
+}
+
+// The vertex term of the last bounce, as a density over the leaving
+// direction.  Mirror facets: the visible normal wh that maps v to target has
+// density D_v(wh), and the reflection Jacobian is 1 / (4 v . wh) (Walter et
+// al. 2007, eq. 14).  Dielectric facets: F times that for reflection;
+// (1 - F) D_v(wh) eta^2 |w . wh| / (v . wh + eta w . wh)^2 for refraction
+// (eq. 16 for wh and eq. 17 for the Jacobian, in the flux form: the walk
+// carries energy from the light).  Lambertian facets: (albedo / pi)
+// <target . wm>+ at the facet wm already drawn from D_v (one-sample estimate
+// of the integral over the visible normals; Heitz and Dupuy 2015).
+double PositionFreeWalk::scatter_density(const glm::dvec3& v, const glm::dvec3& wm, bool same_side,
+                                         const glm::dvec3& target, double eta) const {
+  if (facet_.kind == FacetKind::diffuse) {
+    if (!same_side) return 0.0;
+    return facet_.albedo / kBsdfPi * std::max(glm::dot(target, wm), 0.0);
+  }
+  if (same_side) {
+    const glm::dvec3 sum = v + target;
+    const double length = glm::length(sum);
+    if (!(length > 0.0)) return 0.0;
+    const glm::dvec3 wh = sum / length;
+    const double cos_vh = glm::dot(v, wh);
+    if (wh.z <= 0.0 || cos_vh <= 0.0) return 0.0;
+    const double reflectance = facet_.kind == FacetKind::conductor ? facet_.fresnel.reflectance(cos_vh)
+                                                                   : fresnel_dielectric(cos_vh, eta);
+    const double d = reflectance * distribution_.visible_normal_pdf(v, wh) / (4.0 * cos_vh);
+    return std::isfinite(d) ? d : 0.0;
+  }
+  if (facet_.kind != FacetKind::dielectric) return 0.0;
+  // The target seen from v's side is -target (the other side's frame is the
+  // point mirror of this one).
+  const glm::dvec3 w = -target;
+  const glm::dvec3 sum = v + eta * w;
+  const double length = glm::length(sum);
+  if (!(length > 0.0)) return 0.0;
+  glm::dvec3 wh = sum / length;
+  if (wh.z < 0.0) wh = -wh;
+  const double cos_vh = glm::dot(v, wh);
+  const double cos_wh = glm::dot(w, wh);
+  if (wh.z <= 0.0 || cos_vh <= 0.0 || cos_wh >= 0.0) return 0.0;
+  const double transmittance = 1.0 - fresnel_dielectric(cos_vh, eta);
+  const double denom = cos_vh + eta * cos_wh;
+  const double d = transmittance * distribution_.visible_normal_pdf(v, wh) * eta * eta * std::abs(cos_wh) /
+                   (denom * denom);
+  return std::isfinite(d) ? d : 0.0;
+}
+
+std::optional<PositionFreeWalk::Scatter> PositionFreeWalk::scatter(const glm::dvec3& v, const glm::dvec3& wm,
+                                                                    double eta, RandomSequence& rng) const {
+  const double cos_vm = glm::dot(v, wm);
+  if (!(cos_vm > 0.0)) return std::nullopt;
+  switch (facet_.kind) {
+    case FacetKind::conductor:
+      return Scatter{reflect_about(v, wm), false, facet_.fresnel.reflectance(cos_vm)};
+    case FacetKind::diffuse: {
+      const double u0 = rng.next();
+      const double u1 = rng.next();
+      return Scatter{sample_cosine_around(wm, {u0, u1}), false, facet_.albedo};
+    }
+    case FacetKind::dielectric: {
+      const double reflectance = fresnel_dielectric(cos_vm, eta);
+      if (rng.next() < reflectance) return Scatter{reflect_about(v, wm), false, 1.0};
+      // Snell's law in vector form (pbrt-v4's Refract); the refracted ray
+      // travels on the other side, whose frame is the point mirror.
+      const double sin2_t = (1.0 - cos_vm * cos_vm) / (eta * eta);
+      if (sin2_t >= 1.0) return Scatter{reflect_about(v, wm), false, 1.0};
+      const double cos_t = std::sqrt(1.0 - sin2_t);
+      const glm::dvec3 refracted = glm::normalize(-v / eta + (cos_vm / eta - cos_t) * wm);
+      return Scatter{-refracted, true, 1.0};
+    }
+  }
+  return std::nullopt;
+}
+
+// The unidirectional estimator: f(wo, wi) |wo.z| = sum over orders k of the
+// expected throughput of the first k - 1 bounces times the k-th vertex's
+// connection to wo (its scattering density times its leaving probability).
+double PositionFreeWalk::estimate(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng, int min_order,
+                                  int max_order) const {
+  const bool two_sided = facet_.kind == FacetKind::dielectric;
+  if (wi.z == 0.0 || wo.z == 0.0) return 0.0;
+  if (!two_sided && (wi.z < 0.0 || wo.z < 0.0)) return 0.0;
+  bool outside = wi.z > 0.0;
+  glm::dvec3 v = outside ? wi : -wi;
+  const bool target_outside = wo.z > 0.0;
+  const glm::dvec3 target = target_outside ? wo : -wo;
+  double throughput = 1.0;
+  double total = 0.0;
+  for (int order = 1; order <= max_bounces_ && order <= max_order; ++order) {
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    const double eta = outside ? facet_.eta : 1.0 / facet_.eta;
+    if (order >= min_order) {
+      const double density = scatter_density(v, wm, outside == target_outside, target, eta);
+      if (density > 0.0) total += throughput * density * leave_probability(v, target);
+    }
+    const std::optional<Scatter> s = scatter(v, wm, eta, rng);
+    if (!s) break;
+    throughput *= s->weight;
+    if (!(throughput > 0.0)) break;
+    if (s->crossed) outside = !outside;
+    const double leave = leave_probability(v, s->w);
+    if (leave > 0.0 && rng.next() < leave) break;
+    v = -s->w;
+  }
+  return std::isfinite(total) ? total : 0.0;
+}
+
+std::optional<PositionFreeWalk::Exit> PositionFreeWalk::trace(const glm::dvec3& wi, RandomSequence& rng) const {
+  const bool two_sided = facet_.kind == FacetKind::dielectric;
+  if (wi.z == 0.0 || (!two_sided && wi.z < 0.0)) return std::nullopt;
+  bool outside = wi.z > 0.0;
+  glm::dvec3 v = outside ? wi : -wi;
+  double throughput = 1.0;
+  for (int order = 1; order <= max_bounces_; ++order) {
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    const double eta = outside ? facet_.eta : 1.0 / facet_.eta;
+    const std::optional<Scatter> s = scatter(v, wm, eta, rng);
+    if (!s) return std::nullopt;
+    throughput *= s->weight;
+    if (s->crossed) outside = !outside;
+    const double leave = leave_probability(v, s->w);
+    if (leave > 0.0 && rng.next() < leave) {
+      return Exit{outside ? s->w : -s->w, throughput, order};
+    }
+    v = -s->w;
+  }
+  return std::nullopt;
+}
+
+}  // namespace skyfarm::material
+
+namespace skyfarm::material {
+
+// The bidirectional estimator for mirror / conductor facets.  A path of k
+// bounces has directions v_i (towards the previous bounce; v_1 = wi) and t_i
+// (towards the next; t_k = wo, v_{i+1} = -t_i), and contribution
+//   prod_{i<k} phi(v_i, t_i) c(v_i, t_i)  x  phi(v_k, wo) L(v_k, wo),
+// phi(v, t) = F(v.wh) D_v(wh) / (4 v.wh) the mirror vertex term (wh the half
+// vector), c and L the continue and leave probabilities (leave_probability).
+// Forward sampling draws t_i with density pf_i = D_{v_i}(wh) / (4 v_i.wh)
+// and continues with probability c: weight F per bounce.  Reverse sampling
+// (from wo) draws v_i given t_i with density pr_i = D_{t_i}(wh) / (4 t_i.wh)
+// and continues with probability r, its own leave test: weight
+//   phi(v_i, t_i) / pr_i x (c or L) / r = F G1(v_i) |t_i.z| / (G1(t_i) |v_i.z|) x (c or L) / r.
+// Joining a forward prefix of a draws to a reverse prefix of b draws at
+// vertex j = a + 1 gives a path of k = a + b + 1 bounces; its balance
+// weight is P_j / sum_l P_l with P_l = prod_{i<l} pf_i c_i prod_{i>l} pr_i r_i,
+// the whole densities of the draws, continuation tests included (left out,
+// a reverse draw that nearly always leaves would get a large weight 1 / r).
+double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo,
+                                                RandomSequence& rng) const {
+  if (facet_.kind != FacetKind::conductor) return estimate(wi, wo, rng);
+  if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+  const int cap = std::min(max_bounces_, 64);
+
+  // Forward: forward_v[a] is v_{a+1}; forward_weight[a] the throughput of a draws.
+  std::vector<glm::dvec3> forward_v{wi};
+  std::vector<double> forward_weight{1.0};
+  while (static_cast<int>(forward_v.size()) < cap) {
+    const glm::dvec3 v = forward_v.back();
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    const double cos_vm = glm::dot(v, wm);
+    if (!(cos_vm > 0.0)) break;
+    const glm::dvec3 t = reflect_about(v, wm);
+    const double weight = forward_weight.back() * facet_.fresnel.reflectance(cos_vm);
+    if (!(weight > 0.0)) break;
+    const double leave = leave_probability(v, t);
+    if (leave > 0.0 && rng.next() < leave) break;
+    forward_v.push_back(-t);
+    forward_weight.push_back(weight);
+  }
+
+  // Reverse: reverse_t[b] is the outgoing direction of the joining vertex
+  // after b draws (reverse_t[0] = wo); reverse_weight[b] the throughput.
+  std::vector<glm::dvec3> reverse_t{wo};
+  std::vector<double> reverse_weight{1.0};
+  while (static_cast<int>(reverse_t.size()) < cap) {
+    const glm::dvec3 t = reverse_t.back();
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(t, {u0, u1});
+    const double cos_tm = glm::dot(t, wm);
+    if (!(cos_tm > 0.0)) break;
+    const glm::dvec3 v = reflect_about(t, wm);
+    if (v.z == 0.0) break;
+    const double segment = reverse_t.size() == 1 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+    const double carry = 1.0 - leave_probability(t, v);
+    const double ratio = facet_.fresnel.reflectance(cos_tm) * g1_full_sphere(distribution_, v) * std::abs(t.z) /
+                         (g1_full_sphere(distribution_, t) * std::abs(v.z));
+    const double weight = reverse_weight.back() * ratio * segment / carry;
+    if (!(carry > 0.0) || !(weight > 0.0) || !std::isfinite(weight)) break;
+    if (rng.next() >= carry) break;
+    reverse_t.push_back(-v);
+    reverse_weight.push_back(weight);
+  }
+
+  // The forward and reverse densities of one bounce (v, t), each times the
+  // probability that its walk goes on after it.
+  auto densities = [&](const glm::dvec3& v, const glm::dvec3& t, double* pf, double* pr) {
+    const glm::dvec3 sum = v + t;
+    const double length = glm::length(sum);
+    *pf = 0.0;
+    *pr = 0.0;
+    if (!(length > 0.0)) return;
+    const glm::dvec3 wh = sum / length;
+    const double cos_v = glm::dot(v, wh);
+    const double cos_t = glm::dot(t, wh);
+    if (cos_v <= 0.0 || cos_t <= 0.0) return;
+    *pf = distribution_.visible_normal_pdf(v, wh) / (4.0 * cos_v) * (1.0 - leave_probability(v, t));
+    *pr = distribution_.visible_normal_pdf(t, wh) / (4.0 * cos_t) * (1.0 - leave_probability(t, v));
+  };
+
+  // The densities of the drawn bounces do not depend on where the walks are
+  // joined: forward bounce i is (forward_v[i], -forward_v[i + 1]), reverse
+  // draw m is (-reverse_t[m], reverse_t[m - 1]).
+  const std::size_t na = forward_v.size();
+  const std::size_t nb = reverse_t.size();
+  std::vector<double> forward_pf(na, 0.0);
+  std::vector<double> forward_pr(na, 0.0);
+  for (std::size_t i = 0; i + 1 < na; ++i) densities(forward_v[i], -forward_v[i + 1], &forward_pf[i], &forward_pr[i]);
+  std::vector<double> reverse_pf(nb, 0.0);
+  std::vector<double> reverse_pr(nb, 0.0);
+  for (std::size_t m = 1; m < nb; ++m) densities(-reverse_t[m], reverse_t[m - 1], &reverse_pf[m], &reverse_pr[m]);
+
+  std::vector<double> pf;
+  std::vector<double> pr;
+  double total = 0.0;
+  for (std::size_t a = 0; a < na; ++a) {
+    for (std::size_t b = 0; b < nb; ++b) {
+      const glm::dvec3& v = forward_v[a];
+      const glm::dvec3& t = reverse_t[b];
+      const double phi = scatter_density(v, v, true, t, 1.0);  // mirror: wm unused
+      if (!(phi > 0.0)) continue;
+      const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+      const double contribution = forward_weight[a] * phi * segment * reverse_weight[b];
+      if (!(contribution > 0.0)) continue;
+      // The path's bounces 0..k-1: forward draws, the joining bounce a,
+      // reverse draws (bounce i is reverse draw k - i).
+      const std::size_t k = a + b + 1;
+      pf.assign(k, 0.0);
+      pr.assign(k, 0.0);
+      for (std::size_t i = 0; i < a; ++i) {
+        pf[i] = forward_pf[i];
+        pr[i] = forward_pr[i];
+      }
+      densities(v, t, &pf[a], &pr[a]);
+      for (std::size_t i = a + 1; i < k; ++i) {
+        pf[i] = reverse_pf[k - i];
+        pr[i] = reverse_pr[k - i];
+      }
+      // sum_l P_l / P_j, stepping away from j = a on both sides.
+      double sum = 1.0;
+      double ratio = 1.0;
+      for (std::size_t l = a + 1; l < k; ++l) {
+        ratio *= pf[l - 1] / pr[l];
+        sum += ratio;
+      }
+      ratio = 1.0;
+      for (std::size_t l = a; l-- > 0;) {
+        ratio *= pr[l + 1] / pf[l];
+        sum += ratio;
+      }
+      const double weight = 1.0 / sum;
+      if (std::isfinite(weight)) total += weight * contribution;
+    }
+  }
+  return std::isfinite(total) ? total : 0.0;
+}
+
+}  // namespace skyfarm::material
