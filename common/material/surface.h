@@ -1,0 +1,62 @@
+// A surface made of a material: the request's SurfaceSpec resolved to the
+// material's spectral constants, and the BSDF it has at each wavelength.
+//
+//   kind        roughness 0                    roughness > 0
+//   conductor   SmoothReflector (complex n)    RoughConductor / MultipleBounceBsdf(conductor facets)
+//   dielectric  SmoothReflector (Fresnel)      RoughDielectric / MultipleBounceBsdf(dielectric facets)
+//   diffuse     Lambertian (albedo)            RoughDiffuse / MultipleBounceBsdf(diffuse facets)
+//
+// The single-bounce form is used when spec.multiple_bounce is false.  A
+// dielectric's relative index is its n at the wavelength (the air above
+// counts as 1, its 3e-4 excess is far below the tables' accuracy); its k is
+// not used at the interface (water's k < 1e-8 in the visible) and what is
+// transmitted into it is absorbed (deep water, an opaque body).
+//
+// white_sky_albedo(lambda) is the surface's bihemispherical reflectance: the
+// directional albedo A(mu) = integral f cos dwi averaged over incident
+// directions with weight 2 mu dmu (uniform diffuse illumination).  It is the
+// Lambertian stand-in that methods which know only an albedo (the LUT sky,
+// the roulette control) use for this surface.  Computed by Gauss-Legendre
+// quadrature in mu (16 nodes) and Monte Carlo over sample() (64 per node)
+// with fixed seeds, so it is a deterministic function of the spec.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "common/core/spectral_table.h"
+#include "common/material/material_library.h"
+#include "common/material/surface_bsdf.h"
+#include "common/material/surface_spec.h"
+
+namespace skyfarm::material {
+
+class Surface {
+ public:
+  // Throws std::invalid_argument naming what is wrong (an unknown name, a
+  // bad table entry, a roughness out of range).
+  explicit Surface(SurfaceSpec spec);
+
+  const SurfaceSpec& spec() const { return spec_; }
+  const Material& material() const { return *material_; }
+  MaterialKind kind() const { return material_->kind(); }
+  // A smooth diffuse surface: a Lambertian reflector, all an albedo says.
+  bool lambertian() const { return kind() == MaterialKind::kDiffuse && spec_.smooth(); }
+  // A smooth conductor or dielectric: a delta lobe.
+  bool specular() const { return kind() != MaterialKind::kDiffuse && spec_.smooth(); }
+
+  SurfaceBsdf bsdf(double lambda_nm) const;
+  // The model the table above picks: "lambertian", "smooth_conductor",
+  // "rough_conductor", "multiple_bounce_conductor", ... (dielectric, diffuse).
+  std::string model_name() const;
+
+  double white_sky_albedo(double lambda_nm) const;
+  // white_sky_albedo every step_nm over [lo_nm, hi_nm] (ends included).
+  SpectralTable white_sky_albedo_table(double lo_nm = 360.0, double hi_nm = 830.0, double step_nm = 10.0) const;
+
+ private:
+  SurfaceSpec spec_;
+  std::shared_ptr<const Material> material_;
+};
+
+}  // namespace skyfarm::material
