@@ -5,6 +5,7 @@
 #include "common/atmosphere/aerosol.h"
 #include "common/atmosphere/ozone.h"
 #include "common/atmosphere/rayleigh.h"
+#include "common/material/surface.h"
 
 namespace skyfarm {
 namespace {
@@ -70,7 +71,9 @@ Atmosphere build_atmosphere(const AtmosphereSpec& spec) {
       constituents.push_back(earth_aerosol(*spec.aerosol, spec.top_altitude_m));
   }
   return Atmosphere(spec.planet_radius_m, spec.top_altitude_m, std::move(constituents),
-                    ground_from_spec(spec.ground_albedo));
+                    spec.ground_material ? ground_from_spec(material::Surface(*spec.ground_material)
+                                                                .white_sky_albedo_table())
+                                         : ground_from_spec(spec.ground_albedo));
 }
 
 }  // namespace skyfarm

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/core/spectral_table.h"
+#include "common/material/surface_spec.h"
 
 namespace skyfarm {
 
@@ -92,6 +93,10 @@ struct AtmosphereSpec {
   double ozone_du = 300.0;               // earth presets only
   std::optional<AerosolSpec> aerosol = AerosolSpec{};  // nullopt: no aerosols
   AlbedoSpec ground_albedo = 0.3;
+  // "atmosphere.ground.material": when set, the ground is this surface and
+  // ground_albedo is not used (the Lambertian ground of the tables is the
+  // surface's white-sky albedo, material/surface.h).
+  std::optional<material::SurfaceSpec> ground_material;
   double planet_radius_m = 6371000.0;
   double top_altitude_m = 100000.0;
   std::vector<ConstituentSpec> constituents;  // custom preset only

@@ -14,8 +14,14 @@ Scene::Scene(Atmosphere atmosphere, Sun sun, double observer_altitude_m, double 
 
 Scene Scene::from_specs(const AtmosphereSpec& atmosphere, const SunSpec& sun, const Location& location,
                         const std::optional<UtcInstant>& time, double lambda_min_nm, double lambda_max_nm) {
-  return Scene(build_atmosphere(atmosphere), Sun::from_spec(sun, location, time), location.altitude_m, lambda_min_nm,
-               lambda_max_nm);
+  Scene scene(build_atmosphere(atmosphere), Sun::from_spec(sun, location, time), location.altitude_m, lambda_min_nm,
+              lambda_max_nm);
+  if (atmosphere.ground_material) {
+    auto surface = std::make_shared<const material::Surface>(*atmosphere.ground_material);
+    // A Lambertian material is all its albedo: the atmosphere's ground already is it.
+    if (!surface->lambertian()) scene.ground_surface_ = std::move(surface);
+  }
+  return scene;
 }
 
 }  // namespace skyfarm

@@ -2,7 +2,9 @@
 // tracking structures, the sun, the observer, and the spectral range.
 //
 // Parameters (built from a request's specs by Scene::from_specs):
-//   atmosphere            planet, shell, constituents, ground
+//   atmosphere            planet, shell, constituents, ground (Lambertian: its albedo)
+//   ground_surface        the ground's material when it is not Lambertian
+//                         (null otherwise: a plain ground pays nothing new)
 //   sun                   position, disk, irradiance
 //   observer_altitude_m   the camera / probe position above the ground (on +z)
 //   lambda_min/max_nm     the wavelengths paths may carry (majorants cover them)
@@ -17,6 +19,7 @@
 
 #include "common/atmosphere/atmosphere.h"
 #include "common/atmosphere/atmosphere_spec.h"
+#include "common/material/surface.h"
 #include "common/render/atmosphere_medium.h"
 #include "common/sun/sun.h"
 
@@ -31,6 +34,8 @@ class Scene {
   const Atmosphere& atmosphere() const { return *atmosphere_; }
   const AtmosphereMedium& medium() const { return *medium_; }
   const Sun& sun() const { return sun_; }
+  // The ground's BSDF when it is not Lambertian, else null.
+  const material::Surface* ground_surface() const { return ground_surface_.get(); }
   // Planet-centred observer position (0, 0, R + altitude).
   glm::dvec3 observer() const { return observer_; }
   double observer_altitude_m() const { return observer_.z - atmosphere_->planet_radius_m(); }
@@ -43,6 +48,7 @@ class Scene {
  private:
   std::unique_ptr<Atmosphere> atmosphere_;
   std::unique_ptr<AtmosphereMedium> medium_;
+  std::shared_ptr<const material::Surface> ground_surface_;
   Sun sun_;
   glm::dvec3 observer_;
   double lambda_min_, lambda_max_;

@@ -4,6 +4,7 @@
 #include "common/render/shadow_guide.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 
@@ -12,6 +13,7 @@
 #include "common/core/constants.h"
 #include "common/core/math.h"
 #include "common/geometry/sphere_intersection.h"
+#include "common/material/surface.h"
 #include "common/render/free_flight.h"
 #include "common/render/lit_distance_sampler.h"
 #include "common/render/recorded_shell_walk.h"
@@ -66,6 +68,27 @@ SampledSpectrum mixture_phase(const MediumPoint& mp, const PathPhases& phases, d
   return safe_div(p, mp.sigma_s);
 }
 
+// The ground's local frame at the unit normal n: s towards the east (the
+// anisotropic roughness_x axis), t towards the north, as at the observer
+// (x east, y north, z up).  At the two points where east is undefined any
+// frame will do: no camera looks there.
+Frame ground_frame(const glm::dvec3& n) {
+  const glm::dvec3 east = glm::cross(glm::dvec3(0.0, 1.0, 0.0), n);
+  const double length = glm::length(east);
+  if (!(length > 1e-12)) return Frame(n);
+  Frame f;
+  f.n = n;
+  f.s = east / length;
+  f.t = glm::cross(n, f.s);
+  return f;
+}
+
+// The seed of a BSDF's own random sequence for one stochastic evaluation:
+// one of the path's numbers, so still a pure function of (job seed, pixel,
+// sample, dimension).  Every wavelength's evaluation takes the same seed, so
+// their estimates are correlated as the volume's are (material/bsdf.h).
+std::uint64_t bsdf_seed(Sampler& sampler) { return static_cast<std::uint64_t>(sampler.next() * 0x1.0p53); }
+
 }  // namespace
 
 // A scattering vertex: in the medium (phase function) or on the ground (Lambert).
@@ -79,6 +102,16 @@ struct VolumePathIntegrator::Vertex {
   const PathCoefficients* path = nullptr;
   const PathMajorants* shadow_majorants = nullptr;  // the coarse shells' rows
   SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
+  const SurfaceVertex* surface = nullptr;  // a ground that is a material, not Lambertian
+};
+
+// A ground vertex on a surface that is a material: the local frame (s east,
+// t north, n up), the direction back along the path in it, and the BSDF at
+// each of the path's wavelengths.
+struct VolumePathIntegrator::SurfaceVertex {
+  Frame frame;
+  glm::dvec3 wo;
+  std::array<material::SurfaceBsdf, kWavelengthsPerPath> bsdf;
 };
 
 VolumePathIntegrator::VolumePathIntegrator(const Scene& scene, IntegratorOptions options)
@@ -394,6 +427,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
       *L += st->beta * scene_.environment_radiance * (1.0 / st->r_u.average());
     return false;
   }
+  if (scene_.ground_surface()) return bounce_on_surface(extent, c, depth, ray, st, L);
   // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
   const Atmosphere& atmosphere = scene_.atmosphere();
   const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
@@ -410,6 +444,74 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
   return survives(st, p, wi, depth, c, L);
+}
+
+// A ground that is a material: sun NEE with MIS (unless the surface is
+// smooth: a delta lobe the sun's samples never meet), then the next direction
+// proposed by the hero wavelength's BSDF.  Every wavelength's f is an
+// unbiased estimate (stochastic for the multiple-bounce forms) and its pdf
+// the deterministic density its own proposal would have had, so the spectral
+// MIS ratios r_u are built from pdfs alone (material/bsdf.h says why that
+// keeps MIS unbiased).  A direction below the surface is light that entered
+// it (a dielectric's transmission): absorbed, the path ends.
+//
+// f is evaluated with its arguments swapped, f(wi, wo): the multiple-bounce
+// walk starts on the viewer's side.  The height-correlated microsurface is
+// not reciprocal (Wang et al. 2022, supplement §2.2): its energy is conserved
+// for light arriving from one direction, integral f(wo, wi) |wo.z| dwo = 1,
+// while a path tracer gathers integral f(wo, wi) |wi.z| dwi, which for white
+// Lambertian facets at alpha 1 seen from 10 degrees off the normal is 0.935.
+// Swapped, a non-absorbing ground under a uniform sky returns all its light
+// to the camera, as any closed isothermal scene must.  The reciprocal forms
+// (Lambertian, single-bounce conductor, the smooth reflector, dielectric
+// reflection) are unchanged by the swap.
+bool VolumePathIntegrator::bounce_on_surface(const RayExtent& extent, const PathContext& c, int depth, Ray* ray,
+                                             PathState* st, SampledSpectrum* L) const {
+  const material::Surface& surface = *scene_.ground_surface();
+  const Sun& sun = scene_.sun();
+  const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
+  const glm::dvec3 p = n * (scene_.atmosphere().planet_radius_m() + kGroundOffset_m);
+  SurfaceVertex sv;
+  sv.frame = ground_frame(n);
+  sv.wo = sv.frame.to_local(-ray->d);
+  if (!(sv.wo.z > 0.0)) return false;
+  for (int i = 0; i < kWavelengthsPerPath; ++i) sv.bsdf[i] = surface.bsdf(c.lambda.lambda_nm[i]);
+  const bool specular = sv.bsdf[0].specular();
+  if (scene_.sun_enabled && !specular) {
+    const Vertex v{p, ray->d, true, n, nullptr, nullptr, &c.path, &c.coarse, st->beta, st->r_u, &sv};
+    *L += sample_sun(v, c.lambda, c.sampler, c.counters);
+  }
+  const double uc = c.sampler.next(), u0 = c.sampler.next(), u1 = c.sampler.next();
+  const std::uint64_t seed = bsdf_seed(c.sampler);
+  const std::optional<glm::dvec3> proposed = sv.bsdf[0].propose(sv.wo, uc, {u0, u1});
+  if (!proposed || !(proposed->z > 0.0)) return false;
+  const glm::dvec3 wi = *proposed;
+  if (specular) {
+    // The same mirror direction whatever the hero: r_u unchanged; F per wavelength.
+    for (int i = 0; i < kWavelengthsPerPath; ++i) {
+      material::RandomSequence unused(seed);
+      const std::optional<material::BsdfSample> s = sv.bsdf[i].get().sample(sv.wo, uc, {u0, u1}, unused);
+      st->beta[i] *= s ? s->value : 0.0;
+    }
+    st->mis_with_sun = false;
+  } else {
+    SampledSpectrum f, pdf;
+    for (int i = 0; i < kWavelengthsPerPath; ++i) {
+      material::RandomSequence rng(seed);
+      f[i] = sv.bsdf[i].get().f(wi, sv.wo, rng);
+      pdf[i] = sv.bsdf[i].get().pdf(sv.wo, wi);
+    }
+    const double pdf_hero = pdf[0];
+    if (!(pdf_hero > 0.0)) return false;
+    st->r_l = st->r_u * (1.0 / pdf_hero);
+    st->beta *= f * (wi.z / pdf_hero);
+    st->r_u *= pdf * (1.0 / pdf_hero);
+    st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
+  }
+  st->sun_from_segment_estimator = false;
+  const glm::dvec3 wi_world = glm::normalize(sv.frame.to_world(wi));
+  *ray = Ray{p, wi_world};
+  return survives(st, p, wi_world, depth, c, L);
 }
 
 // Russian roulette on the MIS-normalised throughput after the vertex at
@@ -495,8 +597,19 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (v.on_ground) {
     const double cos_theta = glm::dot(v.n, wi);
     if (cos_theta <= 0.0) return SampledSpectrum(0.0);
-    f = v.path->ground_albedo * (kInvPi * cos_theta);
-    pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
+    if (v.surface) {
+      const glm::dvec3 wi_local = v.surface->frame.to_local(wi);
+      const std::uint64_t seed = bsdf_seed(sampler);
+      for (int i = 0; i < kWavelengthsPerPath; ++i) {
+        material::RandomSequence rng(seed);
+        const material::Bsdf& bsdf = v.surface->bsdf[static_cast<std::size_t>(i)].get();
+        f[i] = bsdf.f(wi_local, v.surface->wo, rng) * cos_theta;  // viewer-side walk: see bounce_on_surface
+        pdf_scatter[i] = bsdf.pdf(v.surface->wo, wi_local);
+      }
+    } else {
+      f = v.path->ground_albedo * (kInvPi * cos_theta);
+      pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
+    }
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
     const ShadowGuide* table = shadow_guide_at(v.p);  // (penumbra: the disk partly seen)

@@ -178,6 +178,7 @@ class VolumePathIntegrator {
 
  private:
   struct Vertex;
+  struct SurfaceVertex;
   // What a path carries between vertices: throughput, spectral-MIS ratios
   // (r_u unidirectional, r_l light sampling; pbrt-v4), and how it got here.
   struct PathState {
@@ -209,6 +210,10 @@ class VolumePathIntegrator {
                          Ray* ray, PathState* st) const;
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
+  // The ground when it is a material (Scene::ground_surface): like
+  // finish_segment's ground branch, with the surface's BSDF.
+  bool bounce_on_surface(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
+                         SampledSpectrum* L) const;
   // Russian roulette after the vertex at p whose next direction is wi (the
   // control variate adds to *L, the light this path has gathered so far).
   bool survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth, const PathContext& c,
