@@ -5,6 +5,8 @@
 #include <set>
 #include <utility>
 
+#include "api/surface_fields.h"
+
 namespace skyfarm::api {
 namespace {
 
@@ -843,7 +845,7 @@ void read_atmosphere(const Fields& top, AtmosphereSpec& out) {
   Errors& e = top.errors();
   if (!v || !expect_object(*v, top.path_of("atmosphere"), e)) return;
   Fields f(*v, top.path_of("atmosphere"), e);
-  f.allow_only({"preset", "ozone_du", "aerosol", "ground_albedo", "planet_radius_m", "top_altitude_m",
+  f.allow_only({"preset", "ozone_du", "aerosol", "ground_albedo", "ground", "planet_radius_m", "top_altitude_m",
                 "constituents"});
   const bool preset_ok = !f.find("preset") || f.choice("preset", kPresets, out.preset);
   const bool custom = preset_ok && out.preset == AtmospherePreset::kCustom;
@@ -861,6 +863,7 @@ void read_atmosphere(const Fields& top, AtmosphereSpec& out) {
     else if (expect_object(*aerosol, path, e)) out.aerosol = read_aerosol(Fields(*aerosol, path, e));
   }
   read_ground_albedo(f, out.ground_albedo);
+  read_ground(f, out);
   f.number("planet_radius_m", Range::closed(1e5, 1e8), out.planet_radius_m);
   f.number("top_altitude_m", Range::closed(1e3, 1e7), out.top_altitude_m);
 
@@ -918,9 +921,13 @@ Json sun_json(const SunSpec& sun) {
 Json atmosphere_json(const AtmosphereSpec& a) {
   const bool custom = a.preset == AtmospherePreset::kCustom;
   Json j = {{"preset", custom ? "custom" : "earth"},
-            {"ground_albedo", albedo_json(a.ground_albedo)},
             {"planet_radius_m", canonical_number(a.planet_radius_m)},
             {"top_altitude_m", canonical_number(a.top_altitude_m)}};
+  // Only a ground that is a material writes "ground" (and then no
+  // ground_albedo): the canonical text of every other request (its hash, its
+  // job's seed) is as it always was.
+  if (a.ground_material) j["ground"] = ground_json(*a.ground_material);
+  else j["ground_albedo"] = albedo_json(a.ground_albedo);
   if (custom) {
     Json cs = Json::array();
     for (const auto& c : a.constituents) cs.push_back(constituent_json(c));

@@ -621,3 +621,82 @@ TEST(RenderRequestCanonical, CustomAtmosphereKeepsOnlyItsFields) {
 
 }  // namespace
 }  // namespace skyfarm::api
+
+namespace skyfarm::api {
+namespace {
+
+// "atmosphere.ground": named materials get their kind, custom ones their
+// tables; the canonical text round-trips and a request without a ground
+// material writes no "ground" (its hash, and so its seed, is unchanged).
+TEST(GroundMaterial, NamedAndCustomMaterialsParseAndRoundTrip) {
+  const RenderRequest water = parse_render_request(
+      with(R"("atmosphere": {"ground": {"material": {"name": "water", "roughness": 0.05}}})"));
+  ASSERT_TRUE(water.atmosphere.ground_material);
+  EXPECT_EQ(water.atmosphere.ground_material->kind, material::MaterialKind::kDielectric);
+  EXPECT_FALSE(water.atmosphere.ground_material->custom);
+  EXPECT_EQ(water.atmosphere.ground_material->roughness_x, 0.05);
+  EXPECT_TRUE(water.atmosphere.ground_material->multiple_bounce);
+
+  const RenderRequest paint = parse_render_request(with(
+      R"("atmosphere": {"ground": {"material": {"name": "paint", "kind": "diffuse", "wavelengths_nm": [400, 700],)"
+      R"( "albedo": [0.2, 0.6], "roughness": [0.3, 0.1], "distribution": "beckmann", "multiple_bounce": false}}})"));
+  ASSERT_TRUE(paint.atmosphere.ground_material);
+  const material::SurfaceSpec& s = *paint.atmosphere.ground_material;
+  EXPECT_TRUE(s.custom);
+  EXPECT_EQ(s.kind, material::MaterialKind::kDiffuse);
+  EXPECT_EQ(s.albedo, (std::vector<double>{0.2, 0.6}));
+  EXPECT_EQ(s.roughness_x, 0.3);
+  EXPECT_EQ(s.roughness_y, 0.1);
+  EXPECT_EQ(s.distribution, material::MicrofacetModel::beckmann);
+  EXPECT_FALSE(s.multiple_bounce);
+
+  for (const RenderRequest* r : {&water, &paint}) {
+    const std::string canonical = canonical_text(*r);
+    EXPECT_EQ(canonical_text(parse_render_request(canonical)), canonical);
+    EXPECT_TRUE(to_canonical_json(*r)["atmosphere"].contains("ground"));
+  }
+  EXPECT_FALSE(to_canonical_json(parse_render_request(with("")))["atmosphere"].contains("ground"));
+}
+
+TEST(GroundMaterial, EveryBadMaterialIsAnErrorNamingItsField) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"name": "unobtainium"})", "atmosphere.ground.material.name"},
+      {R"({"name": "gold", "roughness": 3})", "atmosphere.ground.material.roughness"},
+      {R"({"name": "gold", "roughness": 0.0001})", "atmosphere.ground.material.roughness"},
+      {R"({"name": "gold", "roughness": [0.1, 0]})", "atmosphere.ground.material.roughness"},
+      {R"({"name": "gold", "kind": "conductor"})", "atmosphere.ground.material.kind"},
+      {R"({"name": "gold", "distribution": "phong"})", "atmosphere.ground.material.distribution"},
+      {R"({"name": "gold", "shininess": 3})", "atmosphere.ground.material.shininess"},
+      {R"({"roughness": 0.2})", "atmosphere.ground.material.name"},
+      {R"({"kind": "conductor", "wavelengths_nm": [400, 700], "n": [0.2, 0.3], "k": [3]})",
+       "atmosphere.ground.material.k"},
+      {R"({"kind": "conductor", "wavelengths_nm": [400, 700], "n": [0.2, 0.3]})", "atmosphere.ground.material.k"},
+      {R"({"kind": "dielectric", "wavelengths_nm": [400, 700], "n": [0.5, 1.5]})",
+       "atmosphere.ground.material.n[0]"},
+      {R"({"kind": "conductor", "wavelengths_nm": [400, 700], "n": [-1, 0.3], "k": [3, 3]})",
+       "atmosphere.ground.material.n[0]"},
+      {R"({"kind": "diffuse", "wavelengths_nm": [700, 400], "albedo": [0.2, 0.3]})",
+       "atmosphere.ground.material.wavelengths_nm[1]"},
+      {R"({"kind": "diffuse", "wavelengths_nm": [400, 700], "albedo": [0.2, 1.3]})",
+       "atmosphere.ground.material.albedo[1]"},
+      {R"({"kind": "diffuse", "wavelengths_nm": [400, 700], "n": [1.5, 1.5], "albedo": [0.2, 0.3]})",
+       "atmosphere.ground.material.n"},
+      {R"({"kind": "metal", "wavelengths_nm": [400, 700], "n": [1, 1], "k": [1, 1]})",
+       "atmosphere.ground.material.kind"},
+  };
+  for (const auto& [material, field] : cases) {
+    const auto errors = errors_of(with(R"("atmosphere": {"ground": {"material": )" + material + "}}"));
+    ASSERT_FALSE(errors.empty()) << material;
+    bool named = false;
+    for (const auto& e : errors) named = named || e.path == field;
+    EXPECT_TRUE(named) << material << " -> " << errors.front().message();
+  }
+  EXPECT_FALSE(errors_of(with(R"("atmosphere": {"ground": {}})")).empty());
+  EXPECT_FALSE(errors_of(with(R"("atmosphere": {"ground": 0.3})")).empty());
+  const auto both = errors_of(with(R"("atmosphere": {"ground_albedo": 0.2, "ground": {"material": {"name": "snow"}}})"));
+  ASSERT_EQ(both.size(), 1u);
+  EXPECT_EQ(both.front().path, "atmosphere.ground");
+}
+
+}  // namespace
+}  // namespace skyfarm::api
