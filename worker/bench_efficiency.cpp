@@ -4,13 +4,16 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
-#include <optional>
 #include <array>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "common/core/constants.h"
+#include "common/material/material_library.h"
+#include "common/material/surface_spec.h"
 #include "common/render/radiance_control.h"
 #include "common/render/scene.h"
 #include "common/render/shadow_guide.h"
@@ -33,12 +36,26 @@ glm::dvec3 direction(double zenith_deg, double azimuth_deg) {
   return {std::sin(z) * std::sin(a), std::sin(z) * std::cos(a), std::cos(z)};
 }
 
+// "--ground NAME[:ROUGHNESS]": a named material on the ground.
+std::optional<material::SurfaceSpec> ground_from_arg(const std::string& arg) {
+  material::SurfaceSpec s;
+  const std::size_t colon = arg.find(':');
+  s.name = arg.substr(0, colon);
+  const auto id = material::find_material(s.name);
+  if (!id) return std::nullopt;
+  s.kind = material::named_material(*id).kind();
+  if (colon != std::string::npos) s.roughness_x = s.roughness_y = std::atof(arg.c_str() + colon + 1);
+  return s;
+}
+
 EfficiencyResult measure(double sun_zenith_deg, int samples, IntegratorOptions options, bool roulette_control,
-                         bool shadow_guide) {
+                         bool shadow_guide, const std::optional<material::SurfaceSpec>& ground) {
   SunSpec sun;
   sun.zenith_deg = sun_zenith_deg;
   sun.azimuth_deg = 180.0;
-  const Scene scene = Scene::from_specs(AtmosphereSpec{}, sun, Location{}, std::nullopt, 360.0, 830.0);
+  AtmosphereSpec atmosphere;
+  atmosphere.ground_material = ground;
+  const Scene scene = Scene::from_specs(atmosphere, sun, Location{}, std::nullopt, 360.0, 830.0);
   if (roulette_control) options.roulette_control = std::make_shared<const RadianceControl>(scene);
   if (shadow_guide && shadow_guide_pays(sun_zenith_deg)) options.shadow_guide = std::make_shared<const ShadowGuide>(scene);
   const VolumePathIntegrator integrator(scene, options);
@@ -86,6 +103,8 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
   std::vector<double> suns;
   IntegratorOptions options;
   bool breakdown = false, roulette_control = false, shadow_guide = false;
+  std::optional<material::SurfaceSpec> ground;
+  std::string ground_arg;
   for (std::size_t i = 1; i < args.size(); ++i) {  // args[0] is "efficiency"
     if (args[i] == "--samples" && i + 1 < args.size()) {
       samples = std::max(2, std::atoi(args[++i].c_str()));
@@ -105,6 +124,14 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
       options.rr_start_depth = std::atoi(args[++i].c_str());
     } else if (args[i] == "--rr-threshold-in-shadow" && i + 1 < args.size()) {
       options.rr_threshold_in_shadow = std::atof(args[++i].c_str());
+    } else if (args[i] == "--ground" && i + 1 < args.size()) {
+      ground_arg = args[++i];
+      ground = ground_from_arg(ground_arg);
+      if (!ground) {
+        std::cerr << "bench efficiency: --ground: unknown material \"" << ground_arg
+                  << "\" (known: " << material::known_material_names() << ")\n";
+        return 2;
+      }
     } else if (args[i] == "--breakdown") {
       breakdown = true;
     } else if (args[i] == "--roulette-control") {
@@ -126,16 +153,17 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
                    "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
                    "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n"
-                   "  [--roulette-control] [--shadow-guide]\n";
+                   "  [--roulette-control] [--shadow-guide] [--ground NAME[:ROUGHNESS]]\n";
       return 2;
     }
   }
   if (suns.empty()) suns = {30.0, 85.0, 96.0};
   for (const double sun : suns) {
-    const EfficiencyResult r = measure(sun, samples, options, roulette_control, shadow_guide);
+    const EfficiencyResult r = measure(sun, samples, options, roulette_control, shadow_guide, ground);
     const double rel2 = r.relative_std_per_path * r.relative_std_per_path;
     std::cout << nlohmann::json{{"bench", "efficiency"},
                                 {"sun_zenith_deg", sun},
+                                {"ground", ground ? ground_arg : std::string("lambertian")},
                                 {"samples_per_direction", samples},
                                 {"shadow_majorant_scale", options.shadow_majorant_scale},
                                 {"sunlit_segments", options.explicit_single_scattering},

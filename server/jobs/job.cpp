@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/atmosphere/atmosphere_builder.h"
+#include "common/material/surface.h"
 #include "common/render/render_progress.h"
 
 namespace skyfarm::server {
@@ -24,6 +25,26 @@ std::string unit_text(const WorkUnit& u) {
   return "tile " + std::to_string(u.tile) + ", batch " + std::to_string(u.batch) + ", pass " + std::to_string(u.pass);
 }
 
+namespace {
+
+// The ground as the renderer sees it: its material and BSDF model, and the
+// albedo the tables use (the white-sky albedo of a material) at 550 nm.
+nlohmann::json ground_report(const AtmosphereSpec& spec, const Atmosphere& atmosphere) {
+  nlohmann::json g = {{"albedo_550", atmosphere.ground().albedo(550.0)}};
+  if (!spec.ground_material) {
+    g["material"] = "lambertian";
+    g["model"] = "lambertian";
+    return g;
+  }
+  const material::Surface surface(*spec.ground_material);
+  g["material"] = surface.material().name();
+  g["model"] = surface.model_name();
+  g["roughness"] = {spec.ground_material->roughness_x, spec.ground_material->roughness_y};
+  return g;
+}
+
+}  // namespace
+
 nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& plan) {
   nlohmann::json constituents = nlohmann::json::array(), skipped = nlohmann::json::array();
   const Atmosphere atmosphere = build_atmosphere(request.atmosphere);
@@ -33,7 +54,8 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
     if (!request.atmosphere.aerosol || request.atmosphere.aerosol->optical_depth_550 <= 0.0)
       skipped.push_back("aerosol");
   }
-  return {{"constituents", constituents}, {"skipped", skipped},       {"tiles", plan.tile_count()},
+  return {{"constituents", constituents}, {"skipped", skipped},       {"ground", ground_report(request.atmosphere, atmosphere)},
+          {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
           {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
           {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control},

@@ -65,6 +65,39 @@ TEST(Farm, OneOrThreeWorkersGiveTheSameBytes) {
   }
 }
 
+// A ground that is a material renders on the farm with the bytes of a local
+// render, the status's plan names its model, and the LUT method answers it
+// with the material's white-sky albedo.
+TEST(Farm, MaterialGroundEqualsLocalRender) {
+  constexpr const char* kLake = R"({
+    "sun": {"zenith_deg": 84, "azimuth_deg": 270},
+    "location": {"altitude_m": 3},
+    "camera": {"projection": "equirectangular", "width": 64, "height": 32, "yaw_deg": 270},
+    "atmosphere": {"ground": {"material": {"name": "water", "roughness": 0.05}}},
+    "spectral": {"batches": 2},
+    "quality": {"samples_per_pixel": 16},
+    "output": {"half": false},
+    "seed": 5
+  })";
+  const fs::path dir = fresh_dir("material_ground");
+  const std::string local = testing::local_render_exr(kLake, dir / "local");
+  FarmServer server(dir / "data", 2);
+  ASSERT_TRUE(server.ok()) << server.log();
+  const std::string id = server.submit(kLake);
+  ASSERT_FALSE(id.empty());
+  const auto status = server.wait(id, std::chrono::seconds(90));
+  ASSERT_EQ(status["state"], "done") << status.dump();
+  EXPECT_EQ(status["plan"]["ground"]["material"], "water");
+  EXPECT_EQ(status["plan"]["ground"]["model"], "multiple_bounce_dielectric");
+  EXPECT_EQ(server.download(id, "image.exr"), local);
+
+  std::string lut = kLake;
+  lut.replace(lut.find(R"("seed")"), 0, R"("method": "lut", )");
+  const std::string lut_id = server.submit(lut);
+  ASSERT_FALSE(lut_id.empty());
+  EXPECT_EQ(server.wait(lut_id, std::chrono::seconds(90))["state"], "done");
+}
+
 TEST(Farm, KilledWorkerLosesNothing) {
   const fs::path dir = fresh_dir("kill");
   FarmServer server(dir / "data", 0);
