@@ -1,7 +1,9 @@
 #include "common/material/position_free_walk.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -177,6 +179,14 @@ std::optional<PositionFreeWalk::Exit> PositionFreeWalk::trace(const glm::dvec3& 
 
 namespace skyfarm::material {
 
+namespace {
+
+// The longest walk of the two-way estimators: a non-absorbing walk at
+// alpha = 2 leaves within a few tens of bounces.
+constexpr int kTwoWayCap = 64;
+
+}  // namespace
+
 // The bidirectional estimator for mirror / conductor facets.  A path of k
 // bounces has directions v_i (towards the previous bounce; v_1 = wi) and t_i
 // (towards the next; t_k = wo, v_{i+1} = -t_i), and contribution
@@ -195,6 +205,7 @@ namespace skyfarm::material {
 // a reverse draw that nearly always leaves would get a large weight 1 / r).
 double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo,
                                                 RandomSequence& rng) const {
+  if (facet_.kind == FacetKind::diffuse) return estimate_bidirectional_diffuse(wi, wo, rng);
   if (facet_.kind != FacetKind::conductor) return estimate(wi, wo, rng);
   if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
   const int cap = std::min(max_bounces_, 64);
@@ -307,6 +318,185 @@ double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm:
       for (std::size_t l = a; l-- > 0;) {
         ratio *= pr[l + 1] / pf[l];
         sum += ratio;
+      }
+      const double weight = 1.0 / sum;
+      if (std::isfinite(weight)) total += weight * contribution;
+    }
+  }
+  return std::isfinite(total) ? total : 0.0;
+}
+
+// The bidirectional estimator for Lambertian facets.  The vertex term
+//   phi(v, t) = albedo / pi  integral D_v(wm) <t . wm>+ dwm
+// has no closed form, so each bounce's facet normal wm is part of the path:
+// a bounce is (v, wm, t) with the term (albedo / pi) D_v(wm) <t . wm>+, whose
+// integral over wm is phi (Heitz and Dupuy 2015, stochastic evaluation).
+// The densities of one bounce over that space are then all analytic:
+//   forward  wm from D_v, t cosine-weighted around wm:  D_v(wm) <t . wm> / pi
+//   reverse  wm from D_t, v cosine-weighted around wm:  D_t(wm) <v . wm> / pi
+//   joining  wm from D_v, v and t given by the two walks: D_v(wm)
+// each times the probability that its walk goes on (c = 1 - L(v, t) forward,
+// r = 1 - L(t, v) reverse).  A forward draw weighs albedo; a reverse draw
+// weighs phi / p_reverse = albedo G1(v) |t.z| / (G1(t) |v.z|) times its
+// segment over r, since D_v(wm) |v.z| / G1(v) = <v . wm> D(wm) is symmetric,
+// exactly as for mirror facets.  The joining bounce reuses the normal the
+// forward walk drew there (for its own next draw or its exit) and connects
+// it to the reverse walk's direction: (albedo / pi) <t . wm>+ times the
+// segment.  Strategy l (the joining bounce) of a path of k bounces has the
+// density P_l = prod_{i<l} pf_i x pj_l x prod_{i>l} pr_i, so with
+// A_i = pf_i / pj_i = <t_i . wm_i> c_i / pi and
+// B_i = pr_i / pj_i = <t_i . wm_i> r_i G1(t_i) |v_i.z| / (pi G1(v_i) |t_i.z|)
+// the ratio of neighbours is P_{l+1} / P_l = A_l / B_{l+1}; the balance
+// weight 1 / sum_l (P_l / P_j) is summed from both walks' prefix sums, so
+// every join costs O(1).
+double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, const glm::dvec3& wo,
+                                                        RandomSequence& rng) const {
+  if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
+  const double albedo = facet_.albedo;
+  if (!(albedo > 0.0)) return 0.0;
+  const int cap = std::min(max_bounces_, kTwoWayCap);
+  const bool correlated = correlation_ == HeightCorrelation::correlated;
+
+  // Every direction's Lambda is computed once (it is even in w.z, so v and
+  // -v share it); G1 and the leave probability follow from Lambdas exactly
+  // as g1_full_sphere, g2_full_sphere and leave_probability compute them.
+  auto g1 = [](const glm::dvec3& w, double lambda) {
+    if (w.z > 0.0) return 1.0 / (1.0 + lambda);
+    return lambda == 0.0 ? std::numeric_limits<double>::infinity() : 1.0 / lambda;
+  };
+  auto leave = [&](const glm::dvec3& v, double lambda_v, const glm::dvec3& t, double lambda_t) {
+    if (t.z <= 0.0) return 0.0;
+    double p = 1.0 / (1.0 + lambda_t);
+    if (correlated) {
+      const double arrival = g1(v, lambda_v);
+      const double denominator = v.z > 0.0 ? 1.0 + lambda_v + lambda_t : lambda_v + lambda_t;
+      const double g2 = denominator == 0.0 ? std::numeric_limits<double>::infinity() : 1.0 / denominator;
+      p = std::isfinite(arrival) ? g2 / arrival : 1.0;
+    }
+    return std::isfinite(p) ? std::clamp(p, 0.0, 1.0) : 0.0;
+  };
+  // B of a bounce over <t . wm> / pi: its reverse continuation times the
+  // ratio of the visible-normal normalisations.
+  auto reverse_factor = [&](const glm::dvec3& v, double lambda_v, const glm::dvec3& t, double lambda_t) {
+    return (1.0 - leave(t, lambda_t, v, lambda_v)) * g1(t, lambda_t) * std::abs(v.z) /
+           (g1(v, lambda_v) * std::abs(t.z));
+  };
+
+  // Forward: forward_v[a] is v_{a+1} (forward_lambda its Lambda),
+  // forward_m[a] the normal drawn there; a draws weigh albedo^a.
+  std::array<glm::dvec3, kTwoWayCap> forward_v;
+  std::array<glm::dvec3, kTwoWayCap> forward_m;
+  std::array<double, kTwoWayCap> forward_lambda;
+  forward_v[0] = wi;
+  forward_lambda[0] = distribution_.lambda(wi);
+  int na = 1;
+  for (;;) {
+    const glm::dvec3 v = forward_v[na - 1];
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    forward_m[na - 1] = wm;
+    if (na >= cap || !(glm::dot(v, wm) > 0.0)) break;
+    const double u2 = rng.next();
+    const double u3 = rng.next();
+    const glm::dvec3 t = sample_cosine_around(wm, {u2, u3});
+    const double lambda_t = distribution_.lambda(t);
+    const double p = leave(v, forward_lambda[na - 1], t, lambda_t);
+    if (p > 0.0 && rng.next() < p) break;
+    forward_v[na] = -t;
+    forward_lambda[na] = lambda_t;
+    ++na;
+  }
+
+  // Reverse: reverse_t[b] is the outgoing direction of the joining bounce
+  // after b draws (reverse_t[0] = wo), reverse_m[b >= 1] the normal of draw
+  // b, reverse_weight[b] the throughput.
+  std::array<glm::dvec3, kTwoWayCap> reverse_t;
+  std::array<glm::dvec3, kTwoWayCap> reverse_m;
+  std::array<double, kTwoWayCap> reverse_lambda;
+  std::array<double, kTwoWayCap> reverse_weight;
+  reverse_t[0] = wo;
+  reverse_m[0] = wo;
+  reverse_lambda[0] = distribution_.lambda(wo);
+  reverse_weight[0] = 1.0;
+  int nb = 1;
+  while (nb < cap) {
+    const glm::dvec3 t = reverse_t[nb - 1];
+    const double lambda_t = reverse_lambda[nb - 1];
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(t, {u0, u1});
+    if (!(glm::dot(t, wm) > 0.0)) break;
+    const double u2 = rng.next();
+    const double u3 = rng.next();
+    const glm::dvec3 v = sample_cosine_around(wm, {u2, u3});
+    if (v.z == 0.0) break;
+    const double lambda_v = distribution_.lambda(v);
+    const double p = leave(v, lambda_v, t, lambda_t);
+    const double segment = nb == 1 ? p : 1.0 - p;
+    const double carry = 1.0 - leave(t, lambda_t, v, lambda_v);
+    const double ratio = albedo * g1(v, lambda_v) * std::abs(t.z) / (g1(t, lambda_t) * std::abs(v.z));
+    const double weight = reverse_weight[nb - 1] * ratio * segment / carry;
+    if (!(carry > 0.0) || !(weight > 0.0) || !std::isfinite(weight)) break;
+    if (rng.next() >= carry) break;
+    reverse_t[nb] = -v;
+    reverse_m[nb] = wm;
+    reverse_lambda[nb] = lambda_v;
+    reverse_weight[nb] = weight;
+    ++nb;
+  }
+
+  // Forward bounce i is (forward_v[i], forward_m[i], -forward_v[i + 1]).  At
+  // a join on forward prefix a >= 1, sum_{l<a} P_l / P_a =
+  // B_join / A_{a-1} x down[a], with down[1] = 1 and
+  // down[a] = 1 + B_{a-1} / A_{a-2} x down[a - 1].
+  std::array<double, kTwoWayCap> forward_a;
+  std::array<double, kTwoWayCap> forward_b;
+  std::array<double, kTwoWayCap> down;
+  for (int i = 0; i + 1 < na; ++i) {
+    const glm::dvec3 t = -forward_v[i + 1];
+    const double cos_tm = std::max(glm::dot(t, forward_m[i]), 0.0) / kBsdfPi;
+    forward_a[i] = cos_tm * (1.0 - leave(forward_v[i], forward_lambda[i], t, forward_lambda[i + 1]));
+    forward_b[i] = cos_tm * reverse_factor(forward_v[i], forward_lambda[i], t, forward_lambda[i + 1]);
+  }
+  if (na > 1) down[1] = 1.0;
+  for (int a = 2; a < na; ++a) down[a] = 1.0 + forward_b[a - 1] / forward_a[a - 2] * down[a - 1];
+
+  // Reverse draw m is the bounce (-reverse_t[m], reverse_m[m], reverse_t[m - 1]).
+  // At a join on reverse prefix b >= 1, sum_{l>j} P_l / P_j =
+  // A_join / B_{draw b} x up[b], with up[1] = 1 and
+  // up[b] = 1 + A_{draw b} / B_{draw b-1} x up[b - 1].
+  std::array<double, kTwoWayCap> reverse_a;
+  std::array<double, kTwoWayCap> reverse_b;
+  std::array<double, kTwoWayCap> up;
+  for (int m = 1; m < nb; ++m) {
+    const glm::dvec3 v = -reverse_t[m];
+    const glm::dvec3& t = reverse_t[m - 1];
+    const double cos_tm = std::max(glm::dot(t, reverse_m[m]), 0.0) / kBsdfPi;
+    reverse_a[m] = cos_tm * (1.0 - leave(v, reverse_lambda[m], t, reverse_lambda[m - 1]));
+    reverse_b[m] = cos_tm * reverse_factor(v, reverse_lambda[m], t, reverse_lambda[m - 1]);
+  }
+  if (nb > 1) up[1] = 1.0;
+  for (int b = 2; b < nb; ++b) up[b] = 1.0 + reverse_a[b] / reverse_b[b - 1] * up[b - 1];
+
+  double total = 0.0;
+  double forward_weight = 1.0;
+  for (int a = 0; a < na; ++a, forward_weight *= albedo) {
+    const glm::dvec3& v = forward_v[a];
+    const glm::dvec3& wm = forward_m[a];
+    if (!(glm::dot(v, wm) > 0.0)) continue;
+    for (int b = 0; b < nb; ++b) {
+      const glm::dvec3& t = reverse_t[b];
+      const double cos_tm = glm::dot(t, wm) / kBsdfPi;
+      if (!(cos_tm > 0.0)) continue;
+      const double p = leave(v, forward_lambda[a], t, reverse_lambda[b]);
+      const double segment = b == 0 ? p : 1.0 - p;
+      const double contribution = forward_weight * albedo * cos_tm * segment * reverse_weight[b];
+      if (!(contribution > 0.0)) continue;
+      double sum = 1.0;
+      if (b > 0) sum += cos_tm * (1.0 - p) / reverse_b[b] * up[b];
+      if (a > 0) {
+        sum += cos_tm * reverse_factor(v, forward_lambda[a], t, reverse_lambda[b]) / forward_a[a - 1] * down[a];
       }
       const double weight = 1.0 / sum;
       if (std::isfinite(weight)) total += weight * contribution;
