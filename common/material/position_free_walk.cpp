@@ -206,7 +206,7 @@ constexpr int kTwoWayCap = 64;
 double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo,
                                                 RandomSequence& rng) const {
   if (facet_.kind == FacetKind::diffuse) return estimate_bidirectional_diffuse(wi, wo, rng);
-  if (facet_.kind != FacetKind::conductor) return estimate(wi, wo, rng);
+  if (facet_.kind == FacetKind::dielectric) return estimate_bidirectional_dielectric(wi, wo, rng);
   if (wi.z <= 0.0 || wo.z <= 0.0) return 0.0;
   const int cap = std::min(max_bounces_, 64);
 
@@ -497,6 +497,144 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
       if (b > 0) sum += cos_tm * (1.0 - p) / reverse_b[b] * up[b];
       if (a > 0) {
         sum += cos_tm * reverse_factor(v, forward_lambda[a], t, reverse_lambda[b]) / forward_a[a - 1] * down[a];
+      }
+      const double weight = 1.0 / sum;
+      if (std::isfinite(weight)) total += weight * contribution;
+    }
+  }
+  return std::isfinite(total) ? total : 0.0;
+}
+
+// The bidirectional estimator for dielectric facets: the mirror facets'
+// estimator with two sides.  Each direction is kept in the frame of the side
+// it travels on (outside: as given; inside: point-mirrored, as in
+// estimate()), with the relative index seen from that side.  A forward draw
+// picks reflection or refraction by F, so its density is the vertex term
+// itself (weight 1): F D_v(wh) / (4 v.wh), or (1 - F) D_v(wh) times the
+// refraction Jacobian (scatter_density).  The reverse walk draws the same
+// way from t with the index seen from t's side, and since F is the same
+// from both sides of one facet and D_v(wh) |v.z| / G1(v) = <v.wh> D(wh),
+//   phi(v, t) / p_reverse(v | t) = G1(v) |t.z| / (G1(t) |v.z|)          (reflection)
+//                                = eta_v^2 G1(v) |t.z| / (G1(t) |v.z|)  (refraction),
+// eta_v the relative index seen from v's side: the radiance compression
+// across the interface.  The balance weights are over direction densities
+// (forward: scatter_density(v -> t) c, reverse: scatter_density(t -> v) r).
+double PositionFreeWalk::estimate_bidirectional_dielectric(const glm::dvec3& wi, const glm::dvec3& wo,
+                                                           RandomSequence& rng) const {
+  if (wi.z == 0.0 || wo.z == 0.0) return 0.0;
+  const int cap = std::min(max_bounces_, kTwoWayCap);
+  auto eta_of = [&](bool outside) { return outside ? facet_.eta : 1.0 / facet_.eta; };
+
+  // Forward: forward_v[a] is v_{a+1} in the frame of its side forward_out[a].
+  std::array<glm::dvec3, kTwoWayCap> forward_v;
+  std::array<bool, kTwoWayCap> forward_out;
+  forward_out[0] = wi.z > 0.0;
+  forward_v[0] = forward_out[0] ? wi : -wi;
+  int na = 1;
+  while (na < cap) {
+    const glm::dvec3 v = forward_v[na - 1];
+    const bool outside = forward_out[na - 1];
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(v, {u0, u1});
+    const std::optional<Scatter> s = scatter(v, wm, eta_of(outside), rng);
+    if (!s || !(s->weight > 0.0)) break;
+    const double leave = leave_probability(v, s->w);
+    if (leave > 0.0 && rng.next() < leave) break;
+    forward_v[na] = -s->w;
+    forward_out[na] = s->crossed ? !outside : outside;
+    ++na;
+  }
+
+  // Reverse: reverse_t[b] is the outgoing direction of the joining bounce
+  // after b draws (reverse_t[0] = wo), in the frame of its side reverse_out[b].
+  std::array<glm::dvec3, kTwoWayCap> reverse_t;
+  std::array<bool, kTwoWayCap> reverse_out;
+  std::array<double, kTwoWayCap> reverse_weight;
+  reverse_out[0] = wo.z > 0.0;
+  reverse_t[0] = reverse_out[0] ? wo : -wo;
+  reverse_weight[0] = 1.0;
+  int nb = 1;
+  while (nb < cap) {
+    const glm::dvec3 t = reverse_t[nb - 1];
+    const bool t_outside = reverse_out[nb - 1];
+    const double u0 = rng.next();
+    const double u1 = rng.next();
+    const glm::dvec3 wm = distribution_.sample_visible_normal(t, {u0, u1});
+    const std::optional<Scatter> s = scatter(t, wm, eta_of(t_outside), rng);
+    if (!s || !(s->weight > 0.0)) break;
+    const glm::dvec3 v = s->w;
+    if (v.z == 0.0) break;
+    const bool v_outside = s->crossed ? !t_outside : t_outside;
+    const double segment = nb == 1 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+    const double carry = 1.0 - leave_probability(t, v);
+    const double eta_v = eta_of(v_outside);
+    const double ratio = (s->crossed ? eta_v * eta_v : 1.0) * g1_full_sphere(distribution_, v) * std::abs(t.z) /
+                         (g1_full_sphere(distribution_, t) * std::abs(v.z));
+    const double weight = reverse_weight[nb - 1] * ratio * segment / carry;
+    if (!(carry > 0.0) || !(weight > 0.0) || !std::isfinite(weight)) break;
+    if (rng.next() >= carry) break;
+    reverse_t[nb] = -v;
+    reverse_out[nb] = v_outside;
+    reverse_weight[nb] = weight;
+    ++nb;
+  }
+
+  // The forward and reverse densities of one bounce (v, t), each times the
+  // probability that its walk goes on after it.
+  auto densities = [&](const glm::dvec3& v, bool v_outside, const glm::dvec3& t, bool t_outside, double* pf,
+                       double* pr) {
+    const bool same_side = v_outside == t_outside;
+    *pf = scatter_density(v, v, same_side, t, eta_of(v_outside)) * (1.0 - leave_probability(v, t));
+    *pr = scatter_density(t, t, same_side, v, eta_of(t_outside)) * (1.0 - leave_probability(t, v));
+  };
+
+  // Forward bounce i is (forward_v[i], -forward_v[i + 1]); reverse draw m is
+  // (-reverse_t[m], reverse_t[m - 1]).
+  std::array<double, kTwoWayCap> forward_pf;
+  std::array<double, kTwoWayCap> forward_pr;
+  for (int i = 0; i + 1 < na; ++i) {
+    densities(forward_v[i], forward_out[i], -forward_v[i + 1], forward_out[i + 1], &forward_pf[i], &forward_pr[i]);
+  }
+  std::array<double, kTwoWayCap> reverse_pf;
+  std::array<double, kTwoWayCap> reverse_pr;
+  for (int m = 1; m < nb; ++m) {
+    densities(-reverse_t[m], reverse_out[m], reverse_t[m - 1], reverse_out[m - 1], &reverse_pf[m], &reverse_pr[m]);
+  }
+
+  std::array<double, 2 * kTwoWayCap> pf;
+  std::array<double, 2 * kTwoWayCap> pr;
+  double total = 0.0;
+  for (int a = 0; a < na; ++a) {
+    for (int b = 0; b < nb; ++b) {
+      const glm::dvec3& v = forward_v[a];
+      const glm::dvec3& t = reverse_t[b];
+      const bool same_side = forward_out[a] == reverse_out[b];
+      const double phi = scatter_density(v, v, same_side, t, eta_of(forward_out[a]));
+      if (!(phi > 0.0)) continue;
+      const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+      const double contribution = phi * segment * reverse_weight[b];
+      if (!(contribution > 0.0)) continue;
+      const int k = a + b + 1;
+      for (int i = 0; i < a; ++i) {
+        pf[i] = forward_pf[i];
+        pr[i] = forward_pr[i];
+      }
+      densities(v, forward_out[a], t, reverse_out[b], &pf[a], &pr[a]);
+      for (int i = a + 1; i < k; ++i) {
+        pf[i] = reverse_pf[k - i];
+        pr[i] = reverse_pr[k - i];
+      }
+      double sum = 1.0;
+      double ratio = 1.0;
+      for (int l = a + 1; l < k; ++l) {
+        ratio *= pf[l - 1] / pr[l];
+        sum += ratio;
+      }
+      ratio = 1.0;
+      for (int l = a; l-- > 0;) {
+        ratio *= pr[l + 1] / pf[l];
+        sum += ratio;
       }
       const double weight = 1.0 / sum;
       if (std::isfinite(weight)) total += weight * contribution;

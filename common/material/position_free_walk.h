@@ -33,7 +33,7 @@
 //                   paper's connection of the path to the fixed last
 //                   direction); analytic for mirror and dielectric facets,
 //                   one visible normal for Lambertian facets.
-//   bidirectional   (conductor and diffuse facets) a walk from the light
+//   bidirectional   (every facet kind) a walk from the light
 //                   and one from the viewer, every prefix of one joined to
 //                   every prefix of the other at one vertex; the strategies
 //                   that can make a path of k bounces (the joining vertex
@@ -50,8 +50,10 @@
 //                   of the path (the join reuses the normal the light's walk
 //                   drew there) and the densities are over (normal,
 //                   direction); the gain is smaller (1.2-1.6x less variance
-//                   for about twice the cost of a call).  Dielectric facets
-//                   have the unidirectional estimator only.
+//                   for about twice the cost of a call).  Dielectric
+//                   facets: as mirror facets, on both sides of the interface
+//                   (directions in the frame of their side); a reverse
+//                   refraction weighs eta^2 more than a reverse reflection.
 //
 // Parameters
 //   distribution  the microfacet distribution.
@@ -109,8 +111,7 @@ class PositionFreeWalk {
                   int max_order = 1 << 30) const;
 
   // One estimate of f(wo, wi) |wo.z| by the bidirectional estimator (both
-  // directions above the macro surface).  Conductor and diffuse facets have
-  // it; for dielectric facets this is estimate().
+  // directions above the macro surface, or on either side for a dielectric).
   double estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
 
   // One walk from the light direction wi to its exit: the direction it leaves
@@ -144,8 +145,10 @@ class PositionFreeWalk {
     double weight = 0.0;
   };
   std::optional<Scatter> scatter(const glm::dvec3& v, const glm::dvec3& wm, double eta, RandomSequence& rng) const;
-  // The bidirectional estimator for Lambertian facets (estimate_bidirectional).
+  // The bidirectional estimator for Lambertian and dielectric facets
+  // (estimate_bidirectional).
   double estimate_bidirectional_diffuse(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
+  double estimate_bidirectional_dielectric(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
 
   MicrofacetDistribution distribution_;
   Facet facet_;
