@@ -590,20 +590,29 @@ double PositionFreeWalk::estimate_bidirectional_dielectric(const glm::dvec3& wi,
   };
 
   // Forward bounce i is (forward_v[i], -forward_v[i + 1]); reverse draw m is
-  // (-reverse_t[m], reverse_t[m - 1]).
+  // (-reverse_t[m], reverse_t[m - 1]).  The balance weight's sum
+  // sum_l P_l / P_j, with P_{l+1} / P_l = pf_l / pr_{l+1}, is summed from
+  // both walks' prefix sums (as for Lambertian facets): at a join on
+  // forward prefix a and reverse prefix b,
+  //   sum_{l<a} = pr_join / pf_{a-1} x down[a],  down[a] = 1 + pr_{a-1} / pf_{a-2} x down[a-1],
+  //   sum_{l>a} = pf_join / pr_{draw b} x up[b],  up[b] = 1 + pf_{draw b} / pr_{draw b-1} x up[b-1].
   std::array<double, kTwoWayCap> forward_pf;
   std::array<double, kTwoWayCap> forward_pr;
+  std::array<double, kTwoWayCap> down;
   for (int i = 0; i + 1 < na; ++i) {
     densities(forward_v[i], forward_out[i], -forward_v[i + 1], forward_out[i + 1], &forward_pf[i], &forward_pr[i]);
   }
+  if (na > 1) down[1] = 1.0;
+  for (int a = 2; a < na; ++a) down[a] = 1.0 + forward_pr[a - 1] / forward_pf[a - 2] * down[a - 1];
   std::array<double, kTwoWayCap> reverse_pf;
   std::array<double, kTwoWayCap> reverse_pr;
+  std::array<double, kTwoWayCap> up;
   for (int m = 1; m < nb; ++m) {
     densities(-reverse_t[m], reverse_out[m], reverse_t[m - 1], reverse_out[m - 1], &reverse_pf[m], &reverse_pr[m]);
   }
+  if (nb > 1) up[1] = 1.0;
+  for (int b = 2; b < nb; ++b) up[b] = 1.0 + reverse_pf[b] / reverse_pr[b - 1] * up[b - 1];
 
-  std::array<double, 2 * kTwoWayCap> pf;
-  std::array<double, 2 * kTwoWayCap> pr;
   double total = 0.0;
   for (int a = 0; a < na; ++a) {
     for (int b = 0; b < nb; ++b) {
@@ -615,26 +624,13 @@ double PositionFreeWalk::estimate_bidirectional_dielectric(const glm::dvec3& wi,
       const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
       const double contribution = phi * segment * reverse_weight[b];
       if (!(contribution > 0.0)) continue;
-      const int k = a + b + 1;
-      for (int i = 0; i < a; ++i) {
-        pf[i] = forward_pf[i];
-        pr[i] = forward_pr[i];
-      }
-      densities(v, forward_out[a], t, reverse_out[b], &pf[a], &pr[a]);
-      for (int i = a + 1; i < k; ++i) {
-        pf[i] = reverse_pf[k - i];
-        pr[i] = reverse_pr[k - i];
-      }
       double sum = 1.0;
-      double ratio = 1.0;
-      for (int l = a + 1; l < k; ++l) {
-        ratio *= pf[l - 1] / pr[l];
-        sum += ratio;
-      }
-      ratio = 1.0;
-      for (int l = a; l-- > 0;) {
-        ratio *= pr[l + 1] / pf[l];
-        sum += ratio;
+      if (a > 0 || b > 0) {
+        double pf_join = 0.0;
+        double pr_join = 0.0;
+        densities(v, forward_out[a], t, reverse_out[b], &pf_join, &pr_join);
+        if (b > 0) sum += pf_join / reverse_pr[b] * up[b];
+        if (a > 0) sum += pr_join / forward_pf[a - 1] * down[a];
       }
       const double weight = 1.0 / sum;
       if (std::isfinite(weight)) total += weight * contribution;
