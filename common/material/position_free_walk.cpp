@@ -334,18 +334,25 @@ double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm:
 // The densities of one bounce over that space are then all analytic:
 //   forward  wm from D_v, t cosine-weighted around wm:  D_v(wm) <t . wm> / pi
 //   reverse  wm from D_t, v cosine-weighted around wm:  D_t(wm) <v . wm> / pi
-//   joining  wm from D_v, v and t given by the two walks: D_v(wm)
 // each times the probability that its walk goes on (c = 1 - L(v, t) forward,
 // r = 1 - L(t, v) reverse).  A forward draw weighs albedo; a reverse draw
-// weighs phi / p_reverse = albedo G1(v) |t.z| / (G1(t) |v.z|) times its
-// segment over r, since D_v(wm) |v.z| / G1(v) = <v . wm> D(wm) is symmetric,
-// exactly as for mirror facets.  The joining bounce reuses the normal the
-// forward walk drew there (for its own next draw or its exit) and connects
-// it to the reverse walk's direction: (albedo / pi) <t . wm>+ times the
-// segment.  Strategy l (the joining bounce) of a path of k bounces has the
+// weighs phi / p_reverse = albedo / kappa times its segment over r, with
+//   kappa = G1(t) |v.z| / (G1(v) |t.z|) = D_t(wm) <v . wm> / (D_v(wm) <t . wm>),
+// since D_v(wm) |v.z| / G1(v) = <v . wm> D(wm) is symmetric (as for mirror
+// facets).  The joining bounce has both walks' directions and takes its
+// normal from either walk: the one the light's walk drew at v (density
+// D_v(wm)) or the one the viewer's walk drew at t (D_t(wm)), each drawn
+// anyway for the walk's next step.  The two are combined with shares
+// c_F = 1 / (1 + kappa) and c_R = 1 - c_F (a generalised balance
+// heuristic: the plain one, c = 1/2, triples the variance at grazing light,
+// where D_v alone is nearly exact, and c_F favours the normal seen from the
+// less grazing of v and t), i.e. over the joint density
+// pj = c_F D_v(wm) + c_R D_t(wm).  A joining normal from walk X adds
+//   (albedo / pi) c_X h x segment,  h = <t . wm> <v . wm> / (c_F <v . wm> + c_R kappa <t . wm>),
+// times both walks' weights and the balance weight over the joining
+// bounce.  Strategy l (the joining bounce) of a path of k bounces has the
 // density P_l = prod_{i<l} pf_i x pj_l x prod_{i>l} pr_i, so with
-// A_i = pf_i / pj_i = <t_i . wm_i> c_i / pi and
-// B_i = pr_i / pj_i = <t_i . wm_i> r_i G1(t_i) |v_i.z| / (pi G1(v_i) |t_i.z|)
+//   A_i = pf_i / pj_i = c_i h_i / pi,   B_i = pr_i / pj_i = kappa_i r_i h_i / pi,
 // the ratio of neighbours is P_{l+1} / P_l = A_l / B_{l+1}; the balance
 // weight 1 / sum_l (P_l / P_j) is summed from both walks' prefix sums, so
 // every join costs O(1).
@@ -375,11 +382,15 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
     }
     return std::isfinite(p) ? std::clamp(p, 0.0, 1.0) : 0.0;
   };
-  // B of a bounce over <t . wm> / pi: its reverse continuation times the
-  // ratio of the visible-normal normalisations.
-  auto reverse_factor = [&](const glm::dvec3& v, double lambda_v, const glm::dvec3& t, double lambda_t) {
-    return (1.0 - leave(t, lambda_t, v, lambda_v)) * g1(t, lambda_t) * std::abs(v.z) /
-           (g1(v, lambda_v) * std::abs(t.z));
+  // kappa = G1(t) |v.z| / (G1(v) |t.z|) = D_t(wm) <v.wm> / (D_v(wm) <t.wm>).
+  auto kappa = [&](const glm::dvec3& v, double lambda_v, const glm::dvec3& t, double lambda_t) {
+    return g1(t, lambda_t) * std::abs(v.z) / (g1(v, lambda_v) * std::abs(t.z));
+  };
+  // The share of the light's walk's normal, c_F = 1 / (1 + kappa).
+  auto forward_share = [](double k) { return std::isfinite(k) ? 1.0 / (1.0 + k) : 0.0; };
+  // h = <t.wm> <v.wm> / (c_F <v.wm> + c_R kappa <t.wm>).
+  auto joint = [](double cos_vm, double cos_tm, double k, double c_f) {
+    return cos_vm > 0.0 && cos_tm > 0.0 ? cos_tm * cos_vm / (c_f * cos_vm + (1.0 - c_f) * k * cos_tm) : 0.0;
   };
 
   // Forward: forward_v[a] is v_{a+1} (forward_lambda its Lambda),
@@ -409,24 +420,25 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
   }
 
   // Reverse: reverse_t[b] is the outgoing direction of the joining bounce
-  // after b draws (reverse_t[0] = wo), reverse_m[b >= 1] the normal of draw
-  // b, reverse_weight[b] the throughput.
+  // after b draws (reverse_t[0] = wo), reverse_n[b] the normal drawn there
+  // (so draw b has the normal reverse_n[b - 1]), reverse_weight[b] the
+  // throughput.
   std::array<glm::dvec3, kTwoWayCap> reverse_t;
-  std::array<glm::dvec3, kTwoWayCap> reverse_m;
+  std::array<glm::dvec3, kTwoWayCap> reverse_n;
   std::array<double, kTwoWayCap> reverse_lambda;
   std::array<double, kTwoWayCap> reverse_weight;
   reverse_t[0] = wo;
-  reverse_m[0] = wo;
   reverse_lambda[0] = distribution_.lambda(wo);
   reverse_weight[0] = 1.0;
   int nb = 1;
-  while (nb < cap) {
+  for (;;) {
     const glm::dvec3 t = reverse_t[nb - 1];
     const double lambda_t = reverse_lambda[nb - 1];
     const double u0 = rng.next();
     const double u1 = rng.next();
     const glm::dvec3 wm = distribution_.sample_visible_normal(t, {u0, u1});
-    if (!(glm::dot(t, wm) > 0.0)) break;
+    reverse_n[nb - 1] = wm;
+    if (nb >= cap || !(glm::dot(t, wm) > 0.0)) break;
     const double u2 = rng.next();
     const double u3 = rng.next();
     const glm::dvec3 v = sample_cosine_around(wm, {u2, u3});
@@ -435,16 +447,23 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
     const double p = leave(v, lambda_v, t, lambda_t);
     const double segment = nb == 1 ? p : 1.0 - p;
     const double carry = 1.0 - leave(t, lambda_t, v, lambda_v);
-    const double ratio = albedo * g1(v, lambda_v) * std::abs(t.z) / (g1(t, lambda_t) * std::abs(v.z));
-    const double weight = reverse_weight[nb - 1] * ratio * segment / carry;
+    const double weight = reverse_weight[nb - 1] * albedo * kappa(t, lambda_t, v, lambda_v) * segment / carry;
     if (!(carry > 0.0) || !(weight > 0.0) || !std::isfinite(weight)) break;
     if (rng.next() >= carry) break;
     reverse_t[nb] = -v;
-    reverse_m[nb] = wm;
     reverse_lambda[nb] = lambda_v;
     reverse_weight[nb] = weight;
     ++nb;
   }
+
+  // A bounce's factors A = c h / pi and B = kappa r h / pi (above).
+  auto factors = [&](const glm::dvec3& v, double lambda_v, const glm::dvec3& wm, const glm::dvec3& t,
+                     double lambda_t, double* a, double* b) {
+    const double k = kappa(v, lambda_v, t, lambda_t);
+    const double h = joint(glm::dot(v, wm), glm::dot(t, wm), k, forward_share(k)) / kBsdfPi;
+    *a = h * (1.0 - leave(v, lambda_v, t, lambda_t));
+    *b = h * k * (1.0 - leave(t, lambda_t, v, lambda_v));
+  };
 
   // Forward bounce i is (forward_v[i], forward_m[i], -forward_v[i + 1]).  At
   // a join on forward prefix a >= 1, sum_{l<a} P_l / P_a =
@@ -454,15 +473,13 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
   std::array<double, kTwoWayCap> forward_b;
   std::array<double, kTwoWayCap> down;
   for (int i = 0; i + 1 < na; ++i) {
-    const glm::dvec3 t = -forward_v[i + 1];
-    const double cos_tm = std::max(glm::dot(t, forward_m[i]), 0.0) / kBsdfPi;
-    forward_a[i] = cos_tm * (1.0 - leave(forward_v[i], forward_lambda[i], t, forward_lambda[i + 1]));
-    forward_b[i] = cos_tm * reverse_factor(forward_v[i], forward_lambda[i], t, forward_lambda[i + 1]);
+    factors(forward_v[i], forward_lambda[i], forward_m[i], -forward_v[i + 1], forward_lambda[i + 1], &forward_a[i],
+            &forward_b[i]);
   }
   if (na > 1) down[1] = 1.0;
   for (int a = 2; a < na; ++a) down[a] = 1.0 + forward_b[a - 1] / forward_a[a - 2] * down[a - 1];
 
-  // Reverse draw m is the bounce (-reverse_t[m], reverse_m[m], reverse_t[m - 1]).
+  // Reverse draw m is the bounce (-reverse_t[m], reverse_n[m - 1], reverse_t[m - 1]).
   // At a join on reverse prefix b >= 1, sum_{l>j} P_l / P_j =
   // A_join / B_{draw b} x up[b], with up[1] = 1 and
   // up[b] = 1 + A_{draw b} / B_{draw b-1} x up[b - 1].
@@ -470,11 +487,8 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
   std::array<double, kTwoWayCap> reverse_b;
   std::array<double, kTwoWayCap> up;
   for (int m = 1; m < nb; ++m) {
-    const glm::dvec3 v = -reverse_t[m];
-    const glm::dvec3& t = reverse_t[m - 1];
-    const double cos_tm = std::max(glm::dot(t, reverse_m[m]), 0.0) / kBsdfPi;
-    reverse_a[m] = cos_tm * (1.0 - leave(v, reverse_lambda[m], t, reverse_lambda[m - 1]));
-    reverse_b[m] = cos_tm * reverse_factor(v, reverse_lambda[m], t, reverse_lambda[m - 1]);
+    factors(-reverse_t[m], reverse_lambda[m], reverse_n[m - 1], reverse_t[m - 1], reverse_lambda[m - 1],
+            &reverse_a[m], &reverse_b[m]);
   }
   if (nb > 1) up[1] = 1.0;
   for (int b = 2; b < nb; ++b) up[b] = 1.0 + reverse_a[b] / reverse_b[b - 1] * up[b - 1];
@@ -483,27 +497,35 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
   double forward_weight = 1.0;
   for (int a = 0; a < na; ++a, forward_weight *= albedo) {
     const glm::dvec3& v = forward_v[a];
-    const glm::dvec3& wm = forward_m[a];
-    if (!(glm::dot(v, wm) > 0.0)) continue;
+    const double lambda_v = forward_lambda[a];
     for (int b = 0; b < nb; ++b) {
       const glm::dvec3& t = reverse_t[b];
-      const double cos_tm = glm::dot(t, wm) / kBsdfPi;
-      if (!(cos_tm > 0.0)) continue;
-      const double p = leave(v, forward_lambda[a], t, reverse_lambda[b]);
+      const double lambda_t = reverse_lambda[b];
+      const double p = leave(v, lambda_v, t, lambda_t);
       const double segment = b == 0 ? p : 1.0 - p;
-      const double contribution = forward_weight * albedo * cos_tm * segment * reverse_weight[b];
-      if (!(contribution > 0.0)) continue;
-      double sum = 1.0;
-      if (b > 0) sum += cos_tm * (1.0 - p) / reverse_b[b] * up[b];
-      if (a > 0) {
-        sum += cos_tm * reverse_factor(v, forward_lambda[a], t, reverse_lambda[b]) / forward_a[a - 1] * down[a];
+      const double scale = forward_weight * albedo / kBsdfPi * segment * reverse_weight[b];
+      if (!(scale > 0.0)) continue;
+      const double k = kappa(v, lambda_v, t, lambda_t);
+      const double c_f = forward_share(k);
+      // The two joining normals: the light's walk's (share c_F) and the
+      // viewer's (share c_R = 1 - c_F).
+      for (int x = 0; x < 2; ++x) {
+        const double c_x = x == 0 ? c_f : 1.0 - c_f;
+        if (!(c_x > 0.0)) continue;
+        const glm::dvec3& wm = x == 0 ? forward_m[a] : reverse_n[b];
+        const double h = joint(glm::dot(v, wm), glm::dot(t, wm), k, c_f);
+        if (!(h > 0.0)) continue;
+        double sum = 1.0;
+        if (b > 0) sum += h / kBsdfPi * (1.0 - p) / reverse_b[b] * up[b];
+        if (a > 0) sum += h / kBsdfPi * k * (1.0 - leave(t, lambda_t, v, lambda_v)) / forward_a[a - 1] * down[a];
+        const double weight = 1.0 / sum;
+        if (std::isfinite(weight)) total += weight * scale * c_x * h;
       }
-      const double weight = 1.0 / sum;
-      if (std::isfinite(weight)) total += weight * contribution;
     }
   }
   return std::isfinite(total) ? total : 0.0;
 }
+
 
 // The bidirectional estimator for dielectric facets: the mirror facets'
 // estimator with two sides.  Each direction is kept in the frame of the side

@@ -47,9 +47,10 @@
 //                   density seen from a random direction (smooth surfaces,
 //                   several bounces).  Lambertian facets: the joining vertex
 //                   has no closed form, so each bounce's facet normal is part
-//                   of the path (the join reuses the normal the light's walk
-//                   drew there) and the densities are over (normal,
-//                   direction); the gain is smaller (1.2-1.6x less variance
+//                   of the path (the join takes the normal either walk drew
+//                   there, the two shared by a generalised balance
+//                   heuristic) and the densities are over (normal,
+//                   direction); the gain is smaller (1.1-4x less variance
 //                   for about twice the cost of a call).  Dielectric
 //                   facets: as mirror facets, on both sides of the interface
 //                   (directions in the frame of their side); a reverse
