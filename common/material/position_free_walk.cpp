@@ -643,16 +643,17 @@ double PositionFreeWalk::estimate_bidirectional_dielectric(const glm::dvec3& wi,
       const bool same_side = forward_out[a] == reverse_out[b];
       const double phi = scatter_density(v, v, same_side, t, eta_of(forward_out[a]));
       if (!(phi > 0.0)) continue;
-      const double segment = b == 0 ? leave_probability(v, t) : 1.0 - leave_probability(v, t);
+      const double leave = leave_probability(v, t);
+      const double segment = b == 0 ? leave : 1.0 - leave;
       const double contribution = phi * segment * reverse_weight[b];
       if (!(contribution > 0.0)) continue;
+      // The joining bounce's densities (as densities() computes them).
       double sum = 1.0;
-      if (a > 0 || b > 0) {
-        double pf_join = 0.0;
-        double pr_join = 0.0;
-        densities(v, forward_out[a], t, reverse_out[b], &pf_join, &pr_join);
-        if (b > 0) sum += pf_join / reverse_pr[b] * up[b];
-        if (a > 0) sum += pr_join / forward_pf[a - 1] * down[a];
+      if (b > 0) sum += phi * (1.0 - leave) / reverse_pr[b] * up[b];
+      if (a > 0) {
+        const double pr_join = scatter_density(t, t, same_side, v, eta_of(reverse_out[b])) *
+                               (1.0 - leave_probability(t, v));
+        sum += pr_join / forward_pf[a - 1] * down[a];
       }
       const double weight = 1.0 / sum;
       if (std::isfinite(weight)) total += weight * contribution;
