@@ -63,12 +63,12 @@ TEST(PositionFreeWalk, BidirectionalAndUnidirectionalEstimatorsAgree) {
 }
 
 // Lambertian facets: the whole estimate (order 1 included: both estimators
-// connect a visible normal of wi to wo there, so it adds the same noise to
-// both) at alpha 0.1 to 2, both height models, an anisotropic surface, and
-// grazing light or view.  The two-way estimator must not be noisier than
+// connect a visible normal to wo there) at alpha 0.1 to 2, both height
+// models, an anisotropic surface, Beckmann, and grazing light or view.  The two-way estimator must not be noisier than
 // the one-way one (by a wide margin: it has 1.05-4x less variance).
 TEST(PositionFreeWalk, DiffuseBidirectionalAndUnidirectionalEstimatorsAgree) {
   struct DiffuseCase {
+    MicrofacetModel model;
     double alpha_x;
     double alpha_y;
     HeightCorrelation correlation;
@@ -76,18 +76,23 @@ TEST(PositionFreeWalk, DiffuseBidirectionalAndUnidirectionalEstimatorsAgree) {
     glm::dvec3 wi;
     glm::dvec3 wo;
   };
+  constexpr MicrofacetModel kGgx = MicrofacetModel::ggx;
+  constexpr MicrofacetModel kBeckmann = MicrofacetModel::beckmann;
+  constexpr HeightCorrelation kCorrelated = HeightCorrelation::correlated;
+  constexpr HeightCorrelation kUncorrelated = HeightCorrelation::uncorrelated;
   const DiffuseCase cases[] = {
-      {0.1, 0.1, HeightCorrelation::correlated, 1.0, direction(0.7, 0.0), direction(0.5, 3.0)},
-      {0.1, 0.1, HeightCorrelation::uncorrelated, 0.8, direction(1.45, 0.0), direction(0.2, 1.0)},
-      {0.5, 0.5, HeightCorrelation::correlated, 0.8, direction(0.3, 0.0), direction(1.2, 2.0)},
-      {0.5, 0.5, HeightCorrelation::uncorrelated, 1.0, direction(1.0, 0.0), direction(1.0, 0.0)},
-      {1.0, 1.0, HeightCorrelation::correlated, 1.0, direction(1.5, 0.0), direction(0.4, 0.5)},
-      {1.0, 0.2, HeightCorrelation::correlated, 0.9, direction(0.6, 0.0), direction(1.4, 1.5)},
-      {2.0, 2.0, HeightCorrelation::correlated, 1.0, direction(1.0, 0.0), direction(0.2, 0.5)},
-      {2.0, 2.0, HeightCorrelation::uncorrelated, 0.9, direction(0.0, 0.0), direction(1.5, 3.1)},
+      {kGgx, 0.1, 0.1, kCorrelated, 1.0, direction(0.7, 0.0), direction(0.5, 3.0)},
+      {kGgx, 0.1, 0.1, kUncorrelated, 0.8, direction(1.45, 0.0), direction(0.2, 1.0)},
+      {kGgx, 0.5, 0.5, kCorrelated, 0.8, direction(0.3, 0.0), direction(1.2, 2.0)},
+      {kGgx, 0.5, 0.5, kUncorrelated, 1.0, direction(1.0, 0.0), direction(1.0, 0.0)},
+      {kGgx, 1.0, 1.0, kCorrelated, 1.0, direction(1.5, 0.0), direction(0.4, 0.5)},
+      {kGgx, 1.0, 0.2, kCorrelated, 0.9, direction(0.6, 0.0), direction(1.4, 1.5)},
+      {kGgx, 2.0, 2.0, kCorrelated, 1.0, direction(1.0, 0.0), direction(0.2, 0.5)},
+      {kGgx, 2.0, 2.0, kUncorrelated, 0.9, direction(0.0, 0.0), direction(1.5, 3.1)},
+      {kBeckmann, 0.7, 0.7, kCorrelated, 1.0, direction(1.2, 0.0), direction(1.3, 2.5)},
   };
   for (const DiffuseCase& c : cases) {
-    const MicrofacetDistribution dist(MicrofacetModel::ggx, c.alpha_x, c.alpha_y);
+    const MicrofacetDistribution dist(c.model, c.alpha_x, c.alpha_y);
     const PositionFreeWalk walk(dist, Facet::diffuse(c.albedo), c.correlation);
     RandomSequence rng(47);
     constexpr int kSamples = 40000;
@@ -115,11 +120,13 @@ TEST(PositionFreeWalk, DiffuseBidirectionalAndUnidirectionalEstimatorsAgree) {
 
 // Dielectric facets: reflection and transmission from both sides (the walk
 // crosses the interface in the mirrored frame, and the reverse walk's
-// refraction term carries eta^2), alpha 0.1 to 2, grazing included.  Order
+// refraction term carries eta^2), alpha 0.1 to 2, Beckmann, grazing
+// included.  Order
 // 1 is analytic in both estimators.  The two-way estimator has 1.05-500x
 // less variance here.
 TEST(PositionFreeWalk, DielectricBidirectionalAndUnidirectionalEstimatorsAgree) {
   struct DielectricCase {
+    MicrofacetModel model;
     double alpha;
     HeightCorrelation correlation;
     double eta;
@@ -127,18 +134,23 @@ TEST(PositionFreeWalk, DielectricBidirectionalAndUnidirectionalEstimatorsAgree) 
     glm::dvec3 wo;
   };
   auto below = [](glm::dvec3 w) { return glm::dvec3(w.x, w.y, -w.z); };
+  constexpr MicrofacetModel kGgx = MicrofacetModel::ggx;
+  constexpr MicrofacetModel kBeckmann = MicrofacetModel::beckmann;
+  constexpr HeightCorrelation kCorrelated = HeightCorrelation::correlated;
+  constexpr HeightCorrelation kUncorrelated = HeightCorrelation::uncorrelated;
   const DielectricCase cases[] = {
-      {0.1, HeightCorrelation::correlated, 1.5, direction(0.7, 0.0), below(direction(0.5, 3.0))},
-      {0.5, HeightCorrelation::correlated, 1.33, direction(0.3, 0.0), direction(1.2, 2.0)},
-      {0.5, HeightCorrelation::uncorrelated, 1.5, direction(1.0, 0.0), below(direction(1.0, 0.0))},
-      {1.0, HeightCorrelation::correlated, 1.5, below(direction(1.5, 0.0)), below(direction(0.4, 0.5))},
-      {1.0, HeightCorrelation::correlated, 1.5, below(direction(0.6, 0.0)), direction(0.3, 1.5)},
-      {2.0, HeightCorrelation::correlated, 1.33, direction(1.4, 0.0), below(direction(0.2, 0.5))},
-      {2.0, HeightCorrelation::uncorrelated, 1.5, below(direction(0.2, 0.0)), below(direction(1.5, 3.1))},
-      {0.1, HeightCorrelation::correlated, 1.5, direction(1.5, 0.0), direction(0.9, 3.0)},
+      {kGgx, 0.1, kCorrelated, 1.5, direction(0.7, 0.0), below(direction(0.5, 3.0))},
+      {kGgx, 0.5, kCorrelated, 1.33, direction(0.3, 0.0), direction(1.2, 2.0)},
+      {kGgx, 0.5, kUncorrelated, 1.5, direction(1.0, 0.0), below(direction(1.0, 0.0))},
+      {kGgx, 1.0, kCorrelated, 1.5, below(direction(1.5, 0.0)), below(direction(0.4, 0.5))},
+      {kGgx, 1.0, kCorrelated, 1.5, below(direction(0.6, 0.0)), direction(0.3, 1.5)},
+      {kGgx, 2.0, kCorrelated, 1.33, direction(1.4, 0.0), below(direction(0.2, 0.5))},
+      {kGgx, 2.0, kUncorrelated, 1.5, below(direction(0.2, 0.0)), below(direction(1.5, 3.1))},
+      {kGgx, 0.1, kCorrelated, 1.5, direction(1.5, 0.0), direction(0.9, 3.0)},
+      {kBeckmann, 0.7, kCorrelated, 1.5, below(direction(0.9, 0.0)), direction(0.5, 1.0)},
   };
   for (const DielectricCase& c : cases) {
-    const MicrofacetDistribution dist(MicrofacetModel::ggx, c.alpha, c.alpha);
+    const MicrofacetDistribution dist(c.model, c.alpha, c.alpha);
     const PositionFreeWalk walk(dist, Facet::dielectric(c.eta), c.correlation);
     RandomSequence rng(53);
     constexpr int kSamples = 40000;
