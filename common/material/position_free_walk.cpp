@@ -498,7 +498,8 @@ double PositionFreeWalk::estimate_bidirectional_diffuse(const glm::dvec3& wi, co
   for (int a = 0; a < na; ++a, forward_weight *= albedo) {
     const glm::dvec3& v = forward_v[a];
     const double lambda_v = forward_lambda[a];
-    for (int b = 0; b < nb; ++b) {
+    // Paths of at most `cap` bounces, each with all its strategies.
+    for (int b = 0; b < nb && a + b < cap; ++b) {
       const glm::dvec3& t = reverse_t[b];
       const double lambda_t = reverse_lambda[b];
       const double p = leave(v, lambda_v, t, lambda_t);
@@ -637,7 +638,8 @@ double PositionFreeWalk::estimate_bidirectional_dielectric(const glm::dvec3& wi,
 
   double total = 0.0;
   for (int a = 0; a < na; ++a) {
-    for (int b = 0; b < nb; ++b) {
+    // Paths of at most `cap` bounces, each with all its strategies.
+    for (int b = 0; b < nb && a + b < cap; ++b) {
       const glm::dvec3& v = forward_v[a];
       const glm::dvec3& t = reverse_t[b];
       const bool same_side = forward_out[a] == reverse_out[b];

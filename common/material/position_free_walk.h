@@ -66,7 +66,10 @@
 //                 not reciprocal, supplement §2.2).
 //   max_bounces   a cap on the walk (default 256); a non-absorbing walk at
 //                 alpha = 2 leaves within a few tens of bounces, so the
-//                 truncation is far below the noise.
+//                 truncation is far below the noise.  The bidirectional
+//                 estimator caps each walk at min(max_bounces, 64) (and,
+//                 for diffuse and dielectric facets, the paths it joins at
+//                 that many bounces).
 //
 // Inside a dielectric the walk uses the mirrored frame (w -> -w), in which
 // the inside medium is above the microsurface; the relative index inverts.

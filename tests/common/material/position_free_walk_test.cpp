@@ -176,5 +176,44 @@ TEST(PositionFreeWalk, DielectricBidirectionalAndUnidirectionalEstimatorsAgree) 
   }
 }
 
+// A walk capped at two bounces gives the same truncated BSDF by both
+// estimators (the two-way one joins only paths of at most two bounces, so
+// that each has all its strategies): Lambertian reflection, dielectric
+// transmission.
+TEST(PositionFreeWalk, BothEstimatorsStopAtTheSameOrder) {
+  const MicrofacetDistribution dist(MicrofacetModel::ggx, 1.0, 1.0);
+  for (const Facet& facet : {Facet::diffuse(1.0), Facet::dielectric(1.5)}) {
+    const PositionFreeWalk capped(dist, facet, HeightCorrelation::correlated, 2);
+    const PositionFreeWalk full(dist, facet, HeightCorrelation::correlated);
+    const glm::dvec3 wi = direction(1.2, 0.0);
+    glm::dvec3 wo = direction(0.8, 2.0);
+    if (facet.kind == FacetKind::dielectric) wo.z = -wo.z;
+    RandomSequence rng(61);
+    constexpr int kSamples = 40000;
+    double s[3] = {0.0, 0.0, 0.0};
+    double s2[3] = {0.0, 0.0, 0.0};
+    for (int i = 0; i < kSamples; ++i) {
+      const double x[3] = {capped.estimate(wi, wo, rng), capped.estimate_bidirectional(wi, wo, rng),
+                           full.estimate_bidirectional(wi, wo, rng)};
+      for (int k = 0; k < 3; ++k) {
+        s[k] += x[k];
+        s2[k] += x[k] * x[k];
+      }
+    }
+    double m[3];
+    double v[3];
+    for (int k = 0; k < 3; ++k) {
+      m[k] = s[k] / kSamples;
+      v[k] = (s2[k] / kSamples - m[k] * m[k]) / kSamples;
+    }
+    std::printf("%s, at most 2 bounces: one-way %.6f +- %.6f, two-way %.6f +- %.6f; uncapped two-way %.6f\n",
+                facet.kind == FacetKind::diffuse ? "diffuse" : "dielectric", m[0], std::sqrt(v[0]), m[1],
+                std::sqrt(v[1]), m[2]);
+    EXPECT_NEAR(m[0], m[1], 4.0 * std::sqrt(v[0] + v[1]));
+    // The cap matters here: the orders above 2 are well outside the noise.
+    EXPECT_GT(m[2] - m[1], 6.0 * std::sqrt(v[1] + v[2]));
+  }
+}
+
 }  // namespace
 }  // namespace skyfarm::material
