@@ -187,9 +187,10 @@ constexpr int kTwoWayCap = 64;
 
 }  // namespace
 
-// The bidirectional estimator for mirror / conductor facets.  A path of k
-// bounces has directions v_i (towards the previous bounce; v_1 = wi) and t_i
-// (towards the next; t_k = wo, v_{i+1} = -t_i), and contribution
+// The bidirectional estimator for mirror / conductor facets (Lambertian and
+// dielectric facets have their own, below).  A path of k bounces has
+// directions v_i (towards the previous bounce; v_1 = wi) and t_i (towards
+// the next; t_k = wo, v_{i+1} = -t_i), and contribution
 //   prod_{i<k} phi(v_i, t_i) c(v_i, t_i)  x  phi(v_k, wo) L(v_k, wo),
 // phi(v, t) = F(v.wh) D_v(wh) / (4 v.wh) the mirror vertex term (wh the half
 // vector), c and L the continue and leave probabilities (leave_probability).
@@ -344,9 +345,10 @@ double PositionFreeWalk::estimate_bidirectional(const glm::dvec3& wi, const glm:
 // D_v(wm)) or the one the viewer's walk drew at t (D_t(wm)), each drawn
 // anyway for the walk's next step.  The two are combined with shares
 // c_F = 1 / (1 + kappa) and c_R = 1 - c_F (a generalised balance
-// heuristic: the plain one, c = 1/2, triples the variance at grazing light,
-// where D_v alone is nearly exact, and c_F favours the normal seen from the
-// less grazing of v and t), i.e. over the joint density
+// heuristic: with one normal from each, the plain one, c = 1/2, is noisier
+// than D_v alone at grazing light, where D_v is nearly proportional to the
+// integrand; c_F favours the normal seen from the less grazing of v and t),
+// i.e. over the joint density
 // pj = c_F D_v(wm) + c_R D_t(wm).  A joining normal from walk X adds
 //   (albedo / pi) c_X h x segment,  h = <t . wm> <v . wm> / (c_F <v . wm> + c_R kappa <t . wm>),
 // times both walks' weights and the balance weight over the joining

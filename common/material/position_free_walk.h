@@ -50,8 +50,9 @@
 //                   of the path (the join takes the normal either walk drew
 //                   there, the two shared by a generalised balance
 //                   heuristic) and the densities are over (normal,
-//                   direction); the gain is smaller (1.1-4x less variance
-//                   for about twice the cost of a call).  Dielectric
+//                   direction); the gain is smaller, the one-way
+//                   connection through a Lambertian facet being smooth
+//                   already.  Dielectric
 //                   facets: as mirror facets, on both sides of the interface
 //                   (directions in the frame of their side); a reverse
 //                   refraction weighs eta^2 more than a reverse reflection.
