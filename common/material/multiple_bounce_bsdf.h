@@ -15,9 +15,8 @@
 //                 lobe (default 0.5): the multiple-bounce lobe is broad,
 //                 and a sharper proposal gains little while f is noisy.
 //
-// f() is stochastic: for conductor facets the bidirectional estimator (walks
-// from wi and from wo joined at every pair of prefixes, balance-weighted),
-// for the others one walk from wi with connections to wo (unidirectional),
+// f() is stochastic: the bidirectional estimator (walks from wi and from wo
+// joined at every pair of prefixes, balance-weighted; every facet kind),
 // divided by |wo.z|; the value is in the radiance
 // convention (light from wi seen from wo), which for the dielectric is what
 // conserves energy over wo.  pdf() is the density of sample()'s proposal, a

@@ -33,17 +33,29 @@
 //                   paper's connection of the path to the fixed last
 //                   direction); analytic for mirror and dielectric facets,
 //                   one visible normal for Lambertian facets.
-//   bidirectional   (mirror / conductor facets) a walk from the light and one
-//                   from the viewer, every prefix of one joined to every
-//                   prefix of the other at one vertex whose term is
-//                   evaluated analytically; the strategies that can make a
-//                   path of k bounces (the joining vertex 1..k) are weighted
-//                   by the balance heuristic over their direction densities.
-//                   The reverse walk's vertex terms follow from the forward
-//                   ones by D_v(wh) / (4 v.wh) = G1(v) D(wh) / (4 |v.z|).
-//                   It removes the spikes of the unidirectional connection
-//                   through a sharp facet density seen from a random
-//                   direction (smooth surfaces, several bounces).
+//   bidirectional   (every facet kind) a walk from the light
+//                   and one from the viewer, every prefix of one joined to
+//                   every prefix of the other at one vertex; the strategies
+//                   that can make a path of k bounces (the joining vertex
+//                   1..k) are weighted by the balance heuristic over their
+//                   densities.  The reverse walk's vertex terms follow from
+//                   the forward ones because D_v(wm) |v.z| / G1(v) =
+//                   <v.wm>+ D(wm) is symmetric.  Mirror facets: the joining
+//                   vertex is evaluated analytically (its half vector) and
+//                   the densities are over directions; it removes the spikes
+//                   of the unidirectional connection through a sharp facet
+//                   density seen from a random direction (smooth surfaces,
+//                   several bounces).  Lambertian facets: the joining vertex
+//                   has no closed form, so each bounce's facet normal is part
+//                   of the path (the join takes the normal either walk drew
+//                   there, the two shared by a generalised balance
+//                   heuristic) and the densities are over (normal,
+//                   direction); the gain is smaller, the one-way
+//                   connection through a Lambertian facet being smooth
+//                   already.  Dielectric
+//                   facets: as mirror facets, on both sides of the interface
+//                   (directions in the frame of their side); a reverse
+//                   refraction weighs eta^2 more than a reverse reflection.
 //
 // Parameters
 //   distribution  the microfacet distribution.
@@ -55,7 +67,10 @@
 //                 not reciprocal, supplement §2.2).
 //   max_bounces   a cap on the walk (default 256); a non-absorbing walk at
 //                 alpha = 2 leaves within a few tens of bounces, so the
-//                 truncation is far below the noise.
+//                 truncation is far below the noise.  The bidirectional
+//                 estimator caps each walk at min(max_bounces, 64) (and,
+//                 for diffuse and dielectric facets, the paths it joins at
+//                 that many bounces).
 //
 // Inside a dielectric the walk uses the mirrored frame (w -> -w), in which
 // the inside medium is above the microsurface; the relative index inverts.
@@ -101,8 +116,7 @@ class PositionFreeWalk {
                   int max_order = 1 << 30) const;
 
   // One estimate of f(wo, wi) |wo.z| by the bidirectional estimator (both
-  // directions above the macro surface).  Only conductor facets have it;
-  // for the others this is estimate().
+  // directions above the macro surface, or on either side for a dielectric).
   double estimate_bidirectional(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
 
   // One walk from the light direction wi to its exit: the direction it leaves
@@ -136,6 +150,10 @@ class PositionFreeWalk {
     double weight = 0.0;
   };
   std::optional<Scatter> scatter(const glm::dvec3& v, const glm::dvec3& wm, double eta, RandomSequence& rng) const;
+  // The bidirectional estimator for Lambertian and dielectric facets
+  // (estimate_bidirectional).
+  double estimate_bidirectional_diffuse(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
+  double estimate_bidirectional_dielectric(const glm::dvec3& wi, const glm::dvec3& wo, RandomSequence& rng) const;
 
   MicrofacetDistribution distribution_;
   Facet facet_;
