@@ -127,6 +127,7 @@ struct Case {
 
 struct Comparison {
   Lobe position_free;
+  Lobe uncorrelated;  // the position-free walk without height correlation (with the Heitz walk only)
   Lobe heitz;
   Lobe heightfield;
   int below = 0;
@@ -141,6 +142,20 @@ Comparison compare(const Case& c, double theta, int walks, std::uint64_t seed, b
                                 HeightCorrelation::correlated);
     RandomSequence rng(seed * 3 + 1);
     out.position_free = tally(
+        [&](glm::dvec3* w, int* order) {
+          const auto exit = walk.trace(wi, rng);
+          if (!exit) return false;
+          *w = exit->direction;
+          *order = exit->bounces;
+          return true;
+        },
+        walks);
+  }
+  if (with_heitz) {
+    const PositionFreeWalk walk(dist, c.diffuse ? Facet::diffuse(1.0) : Facet::conductor(ConductorFresnel::mirror()),
+                                HeightCorrelation::uncorrelated);
+    RandomSequence rng(seed * 3 + 1);
+    out.uncorrelated = tally(
         [&](glm::dvec3* w, int* order) {
           const auto exit = walk.trace(wi, rng);
           if (!exit) return false;
@@ -188,6 +203,7 @@ void print(const Case& c, double theta, const Comparison& r, bool with_heitz) {
   };
   std::printf("%s theta %.1f\n", c.name.c_str(), theta);
   row("position-free", r.position_free);
+  if (with_heitz) row("uncorrelated", r.uncorrelated);
   if (with_heitz) row("Heitz", r.heitz);
   row("heightfield", r.heightfield);
   auto pair = [](const char* name, const Lobe& a, const Lobe& b) {
@@ -199,6 +215,7 @@ void print(const Case& c, double theta, const Comparison& r, bool with_heitz) {
   if (with_heitz) {
     pair("Heitz, hf", r.heitz, r.heightfield);
     pair("pf, Heitz", r.position_free, r.heitz);
+    pair("uncorr, hf", r.uncorrelated, r.heightfield);
   }
   std::printf("  below %d\n", r.below);
 }
@@ -273,12 +290,15 @@ const Case kFig7{"diffuse 1.0 x 0.1", 1.0, 0.1, true};
 const Case kFig8{"conductor 0.25", 0.25, 0.25, false};
 
 // What the position-free walk shows against the heightfield at one
-// incidence angle.  The bands are measured (3 surfaces and ray streams,
-// 200 000 walks each; docs/experiments/2026-12-03-heightfield-reference.md),
-// widened by 4 standard errors of the run at hand, which the test computes
-// from its counts:
+// incidence angle.  The bands are the extremes measured over 6 surfaces and
+// ray streams (seeds 1-6 of the runs below, and 3 runs of 200 000 walks;
+// docs/experiments/2026-12-03-heightfield-reference.md), rounded outwards,
+// then widened by 4 standard errors of the rays of the run at hand, which
+// the test computes from its counts.  The surfaces differ among themselves
+// more than the rays do (at grazing incidence the ratio spreads by ~+-5 %
+// from one surface to the next): the extremes carry that spread.
 //   ratio    E_r of the bounces >= 2, position-free over heightfield.  Where
-//            Smith's model holds (theta 0.5) they agree within 2 %; towards
+//            Smith's model holds (theta 0.5) they agree within 3 %; towards
 //            grazing incidence the real surface sends less light into second
 //            bounces than Smith's masking predicts, and the Heitz walk
 //            agrees with the position-free one there, so the gap is Smith's,
@@ -286,7 +306,8 @@ const Case kFig8{"conductor 0.25", 0.25, 0.25, false};
 //   l1       the lobe's L1 distance beyond what noise alone would give: the
 //            bound is l1 + 1.5 x the noise floor of the run's counts (the
 //            observed L1 is at most the true distance plus the noise's, and
-//            the noise's own spread is ~15 % of its floor).
+//            the noise's own spread is ~15 % of its floor); l1 is the
+//            largest excess measured plus 0.03-0.04.
 struct Expectation {
   double theta;
   double ratio_lo;
@@ -318,29 +339,30 @@ Comparison check(const Case& c, const Expectation& e, int walks, std::uint64_t s
 // Walk counts: enough that the bounces >= 2 have some 10 000 walks (their
 // energy is then known to ~1 %), fewer where they are common.
 void fig4(std::uint64_t seed) {
-  check(kFig4, {0.5, 0.98, 1.02, 0.05}, 300000, seed);
-  check(kFig4, {1.5, 1.03, 1.09, 0.05}, 300000, seed);
+  check(kFig4, {0.5, 0.97, 1.03, 0.03}, 300000, seed);
+  check(kFig4, {1.5, 1.04, 1.10, 0.03}, 300000, seed);
 }
 void fig5(std::uint64_t seed) {
-  check(kFig5, {0.5, 0.98, 1.02, 0.05}, 150000, seed);
-  check(kFig5, {1.5, 1.07, 1.14, 0.05}, 150000, seed);
+  check(kFig5, {0.5, 0.97, 1.02, 0.04}, 150000, seed);
+  check(kFig5, {1.5, 1.03, 1.14, 0.04}, 150000, seed);
 }
 void fig6(std::uint64_t seed) {
-  check(kFig6, {0.5, 0.98, 1.02, 0.10}, 100000, seed);
-  check(kFig6, {1.5, 1.06, 1.12, 0.10}, 100000, seed);
+  check(kFig6, {0.5, 0.97, 1.01, 0.08}, 100000, seed);
+  check(kFig6, {1.5, 1.05, 1.11, 0.06}, 100000, seed);
 }
 void fig7(std::uint64_t seed) {
-  check(kFig7, {0.5, 0.98, 1.02, 0.10}, 100000, seed);
-  check(kFig7, {1.5, 1.14, 1.20, 0.10}, 100000, seed);
+  check(kFig7, {0.5, 0.97, 1.01, 0.04}, 100000, seed);
+  check(kFig7, {1.5, 1.13, 1.19, 0.08}, 100000, seed);
 }
 // The mirror conductor also against the supplement's printed E_r: at
 // theta 1.5 its Fig. 8 gives the second bounce 0.048 for its position-free
 // model and for Heitz et al.'s walk, 0.034 for its simulated surface.  The
 // tolerance is the printed rounding (0.0005), the spread of the second
-// bounce over our surfaces (0.0015) and 4 standard errors.
+// bounce over our surfaces (0.0334-0.0354 on 6, and 0.0484-0.0501 for the
+// walks: 0.0015) and 4 standard errors.
 void fig8(std::uint64_t seed) {
-  check(kFig8, {1.0, 1.06, 1.12, 0.30}, 200000, seed);
-  const Comparison r = check(kFig8, {1.5, 1.22, 1.34, 0.45}, 200000, seed, true);
+  check(kFig8, {1.0, 1.05, 1.12, 0.23}, 200000, seed);
+  const Comparison r = check(kFig8, {1.5, 1.24, 1.33, 0.42}, 200000, seed, true);
   auto near = [](const Lobe& l, double printed, const char* who) {
     const double e2 = l.energy[1];
     const double tolerance = 0.0005 + 0.0015 + 4.0 * std::sqrt(e2 * (1.0 - e2) / l.walks);
