@@ -80,7 +80,8 @@ TEST(Farm, MaterialGroundEqualsLocalRender) {
     "seed": 5
   })";
   const fs::path dir = fresh_dir("material_ground");
-  const std::string local = testing::local_render_exr(kLake, dir / "local");
+  const std::string local = testing::local_render_exr(kLake, fresh_dir("material_ground_local"));
+  ASSERT_FALSE(local.empty());
   FarmServer server(dir / "data", 2);
   ASSERT_TRUE(server.ok()) << server.log();
   const std::string id = server.submit(kLake);
