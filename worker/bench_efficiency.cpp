@@ -36,7 +36,8 @@ glm::dvec3 direction(double zenith_deg, double azimuth_deg) {
   return {std::sin(z) * std::sin(a), std::sin(z) * std::cos(a), std::cos(z)};
 }
 
-// "--ground NAME[:ROUGHNESS]": a named material on the ground.
+// "--ground NAME[:ROUGHNESS[:single]]": a named material on the ground
+// (":single" for the single-bounce BSDF).
 std::optional<material::SurfaceSpec> ground_from_arg(const std::string& arg) {
   material::SurfaceSpec s;
   const std::size_t colon = arg.find(':');
@@ -45,6 +46,7 @@ std::optional<material::SurfaceSpec> ground_from_arg(const std::string& arg) {
   if (!id) return std::nullopt;
   s.kind = material::named_material(*id).kind();
   if (colon != std::string::npos) s.roughness_x = s.roughness_y = std::atof(arg.c_str() + colon + 1);
+  s.multiple_bounce = !arg.ends_with(":single");
   return s;
 }
 
@@ -153,7 +155,7 @@ int run_bench_efficiency(const std::vector<std::string>& args) {
                    "[--shadow-scale S] [--sunlit-segments] [--no-sunlit-in-shadow] [--plain-ratio-tracking] [--max-depth N]\n"
                    "  [--forced-segments K] [--camera-collisions N] [--max-camera-scale S] [--rr-start-depth D]\n"
                    "  [--rr-threshold-in-shadow W] [--residual-below-cos C] [--residual-below-altitude M] [--breakdown]\n"
-                   "  [--roulette-control] [--shadow-guide] [--ground NAME[:ROUGHNESS]]\n";
+                   "  [--roulette-control] [--shadow-guide] [--ground NAME[:ROUGHNESS[:single]]]\n";
       return 2;
     }
   }

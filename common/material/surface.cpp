@@ -56,9 +56,11 @@ SurfaceBsdf Surface::bsdf(double lambda_nm) const {
     }
     case MaterialKind::kDielectric: {
       const double eta = material_->ior().n(lambda_nm);
+      // Over an opaque body: only the reflected directions are proposed.
       if (spec_.smooth()) return SurfaceBsdf(SmoothReflector::dielectric(eta));
-      if (spec_.multiple_bounce) return SurfaceBsdf(MultipleBounceBsdf(d, Facet::dielectric(eta)));
-      return SurfaceBsdf(RoughDielectric(d, eta));
+      if (spec_.multiple_bounce)
+        return SurfaceBsdf::reflection_only(MultipleBounceBsdf(d, Facet::dielectric(eta)), d, 0.25);
+      return SurfaceBsdf::reflection_only(RoughDielectric(d, eta), d, 0.0);
     }
     case MaterialKind::kDiffuse: {
       const double albedo = std::clamp(material_->albedo().at(lambda_nm), 0.0, 1.0);
@@ -100,8 +102,16 @@ double Surface::white_sky_albedo(double lambda_nm) const {
       const double phi = 2.0 * kBsdfPi * rng.next();  // every azimuth: anisotropic surfaces
       const glm::dvec3 wo(sin_theta * std::cos(phi), sin_theta * std::sin(phi), mu);
       const double uc = rng.next(), u0 = rng.next(), u1 = rng.next();
-      const std::optional<BsdfSample> sample = b.sample(wo, uc, {u0, u1}, rng);
-      if (sample && sample->wi.z > 0.0 && std::isfinite(sample->value)) sum += sample->value;
+      if (surface_bsdf.specular()) {
+        const std::optional<BsdfSample> sample = b.sample(wo, uc, {u0, u1}, rng);
+        if (sample && std::isfinite(sample->value)) sum += sample->value;
+        continue;
+      }
+      // The proposal the path tracer uses, f with the walk from the viewer's side.
+      const std::optional<glm::dvec3> wi = surface_bsdf.propose(wo, uc, {u0, u1});
+      if (!wi || !(wi->z > 0.0)) continue;
+      const double value = b.f(*wi, wo, rng) * wi->z / surface_bsdf.pdf(wo, *wi);
+      if (std::isfinite(value)) sum += value;
     }
     total += weight * 2.0 * mu * (sum / n);
   }

@@ -1,6 +1,14 @@
 // One surface's BSDF at one wavelength, held by value: the path tracer
 // builds one per wavelength of a path at every surface vertex (a few doubles
 // each, no allocation) and calls them through the Bsdf interface.
+//
+// A surface over an opaque body (the ground: what a dielectric transmits is
+// absorbed in the deep water below) needs only the reflected directions.
+// reflection_only() replaces the BSDF's own proposal, which for water sends
+// ~95 % of its samples into the water, by one over the upper hemisphere: the
+// mirror of wo about a visible normal (Heitz 2018), mixed with a cosine-
+// weighted hemisphere with probability cosine_share.  propose() and pdf()
+// below are then that proposal and its density; f is the BSDF's.
 #pragma once
 
 #include <optional>
@@ -22,6 +30,14 @@ class SurfaceBsdf {
   template <class B>
   explicit SurfaceBsdf(B bsdf) : bsdf_(std::move(bsdf)) {}
 
+  // The BSDF with the reflection-only proposal (see the top of this file).
+  template <class B>
+  static SurfaceBsdf reflection_only(B bsdf, const MicrofacetDistribution& distribution, double cosine_share) {
+    SurfaceBsdf s(std::move(bsdf));
+    s.reflection_ = Reflection{distribution, cosine_share};
+    return s;
+  }
+
   bool empty() const { return std::holds_alternative<std::monostate>(bsdf_); }
   // Precondition: !empty().
   const Bsdf& get() const {
@@ -34,22 +50,23 @@ class SurfaceBsdf {
   }
   bool specular() const { return std::holds_alternative<SmoothReflector>(bsdf_); }
 
-  // A direction drawn from sample()'s proposal (density pdf(wo, .)) without
+  // A direction drawn from the proposal (density pdf(wo, .)) without
   // evaluating f: the path tracer proposes with the hero wavelength's BSDF
   // and evaluates f and pdf at every wavelength.  nullopt when the proposal
   // fails.
-  std::optional<glm::dvec3> propose(const glm::dvec3& wo, double uc, const glm::dvec2& u) const {
-    if (const auto* m = std::get_if<MultipleBounceBsdf>(&bsdf_)) return m->propose(wo, uc, u);
-    RandomSequence unused(0);  // the exact forms draw nothing; rough diffuse's draws only feed its f
-    const std::optional<BsdfSample> s = get().sample(wo, uc, u, unused);
-    if (!s) return std::nullopt;
-    return s->wi;
-  }
+  std::optional<glm::dvec3> propose(const glm::dvec3& wo, double uc, const glm::dvec2& u) const;
+  // The proposal's density over solid angle (deterministic).
+  double pdf(const glm::dvec3& wo, const glm::dvec3& wi) const;
 
  private:
+  struct Reflection {
+    MicrofacetDistribution distribution;
+    double cosine_share = 0.0;
+  };
   std::variant<std::monostate, Lambertian, RoughConductor, RoughDielectric, RoughDiffuse, MultipleBounceBsdf,
                SmoothReflector>
       bsdf_;
+  std::optional<Reflection> reflection_;
 };
 
 }  // namespace skyfarm::material

@@ -499,7 +499,7 @@ bool VolumePathIntegrator::bounce_on_surface(const RayExtent& extent, const Path
     for (int i = 0; i < kWavelengthsPerPath; ++i) {
       material::RandomSequence rng(seed);
       f[i] = sv.bsdf[i].get().f(wi, sv.wo, rng);
-      pdf[i] = sv.bsdf[i].get().pdf(sv.wo, wi);
+      pdf[i] = sv.bsdf[i].pdf(sv.wo, wi);
     }
     const double pdf_hero = pdf[0];
     if (!(pdf_hero > 0.0)) return false;
@@ -604,7 +604,7 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
         material::RandomSequence rng(seed);
         const material::Bsdf& bsdf = v.surface->bsdf[static_cast<std::size_t>(i)].get();
         f[i] = bsdf.f(wi_local, v.surface->wo, rng) * cos_theta;  // viewer-side walk: see bounce_on_surface
-        pdf_scatter[i] = bsdf.pdf(v.surface->wo, wi_local);
+        pdf_scatter[i] = v.surface->bsdf[static_cast<std::size_t>(i)].pdf(v.surface->wo, wi_local);
       }
     } else {
       f = v.path->ground_albedo * (kInvPi * cos_theta);
