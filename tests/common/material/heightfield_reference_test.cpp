@@ -26,6 +26,7 @@
 #include "common/material/position_free_walk.h"
 #include "tests/common/material/heightfield_random_walk.h"
 #include "tests/common/material/heitz_random_walk.h"
+#include "tests/common/material/lobe_distance.h"
 #include "tests/common/material/microsurface_heightfield.h"
 
 namespace skyfarm::material {
@@ -87,18 +88,7 @@ Lobe tally(Trace trace, int walks) {
   return lobe;
 }
 
-// The L1 distance between two binned lobes, each normalised to unit energy.
-double l1_distance(const std::vector<double>& a, const std::vector<double>& b) {
-  double sa = 0.0;
-  double sb = 0.0;
-  for (int k = 0; k < kBins; ++k) {
-    sa += a[k];
-    sb += b[k];
-  }
-  double d = 0.0;
-  for (int k = 0; k < kBins; ++k) d += std::abs(a[k] / sa - b[k] / sb);
-  return d;
-}
+using testing::l1_distance;
 
 // What two lobes drawn from the SAME distribution would show as L1 distance,
 // from the counts alone: each normalised bin is off by a normal error of

@@ -16,6 +16,7 @@
 
 #include "common/material/position_free_walk.h"
 #include "tests/common/material/heitz_random_walk.h"
+#include "tests/common/material/lobe_distance.h"
 
 namespace skyfarm::material {
 namespace {
@@ -53,19 +54,7 @@ double chi_square(const std::vector<double>& a, const std::vector<double>& b, in
   return chi;
 }
 
-// The L1 distance between the two multiple-bounce lobes, each normalised to
-// unit energy.
-double l1_distance(const std::vector<double>& a, const std::vector<double>& b) {
-  double sa = 0.0;
-  double sb = 0.0;
-  for (int k = 0; k < kBins; ++k) {
-    sa += a[k];
-    sb += b[k];
-  }
-  double d = 0.0;
-  for (int k = 0; k < kBins; ++k) d += std::abs(a[k] / sa - b[k] / sb);
-  return d;
-}
+using testing::l1_distance;
 
 struct Case {
   std::string name;

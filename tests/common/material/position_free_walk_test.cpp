@@ -62,6 +62,30 @@ TEST(PositionFreeWalk, BidirectionalAndUnidirectionalEstimatorsAgree) {
   }
 }
 
+// The one-way and two-way estimates of f(wo, wi) |wo.z|, 40 000 each from
+// one sequence: their means and the variances of the means.
+struct BothEstimates {
+  double one_way, one_way_variance, two_way, two_way_variance;
+};
+BothEstimates both_estimators(const PositionFreeWalk& walk, const glm::dvec3& wi, const glm::dvec3& wo,
+                              std::uint64_t seed) {
+  RandomSequence rng(seed);
+  constexpr int kSamples = 40000;
+  double s[2] = {0.0, 0.0};
+  double s2[2] = {0.0, 0.0};
+  for (int i = 0; i < kSamples; ++i) {
+    const double uni = walk.estimate(wi, wo, rng);
+    const double bi = walk.estimate_bidirectional(wi, wo, rng);
+    s[0] += uni;
+    s2[0] += uni * uni;
+    s[1] += bi;
+    s2[1] += bi * bi;
+  }
+  const double m0 = s[0] / kSamples;
+  const double m1 = s[1] / kSamples;
+  return {m0, (s2[0] / kSamples - m0 * m0) / kSamples, m1, (s2[1] / kSamples - m1 * m1) / kSamples};
+}
+
 // Lambertian facets: the whole estimate (order 1 included: both estimators
 // connect a visible normal to wo there) at alpha 0.1 to 2, both height
 // models, an anisotropic surface, Beckmann, and grazing light or view.  The
@@ -95,22 +119,7 @@ TEST(PositionFreeWalk, DiffuseBidirectionalAndUnidirectionalEstimatorsAgree) {
   for (const DiffuseCase& c : cases) {
     const MicrofacetDistribution dist(c.model, c.alpha_x, c.alpha_y);
     const PositionFreeWalk walk(dist, Facet::diffuse(c.albedo), c.correlation);
-    RandomSequence rng(47);
-    constexpr int kSamples = 40000;
-    double s[2] = {0.0, 0.0};
-    double s2[2] = {0.0, 0.0};
-    for (int i = 0; i < kSamples; ++i) {
-      const double uni = walk.estimate(c.wi, c.wo, rng);
-      const double bi = walk.estimate_bidirectional(c.wi, c.wo, rng);
-      s[0] += uni;
-      s2[0] += uni * uni;
-      s[1] += bi;
-      s2[1] += bi * bi;
-    }
-    const double m0 = s[0] / kSamples;
-    const double m1 = s[1] / kSamples;
-    const double v0 = (s2[0] / kSamples - m0 * m0) / kSamples;
-    const double v1 = (s2[1] / kSamples - m1 * m1) / kSamples;
+    const auto [m0, v0, m1, v1] = both_estimators(walk, c.wi, c.wo, 47);
     std::printf("diffuse alpha %.1f x %.1f: unidirectional %.6f +- %.6f, bidirectional %.6f +- %.6f\n", c.alpha_x,
                 c.alpha_y, m0, std::sqrt(v0), m1, std::sqrt(v1));
     EXPECT_GT(m0, 0.0);
@@ -152,22 +161,7 @@ TEST(PositionFreeWalk, DielectricBidirectionalAndUnidirectionalEstimatorsAgree) 
   for (const DielectricCase& c : cases) {
     const MicrofacetDistribution dist(c.model, c.alpha, c.alpha);
     const PositionFreeWalk walk(dist, Facet::dielectric(c.eta), c.correlation);
-    RandomSequence rng(53);
-    constexpr int kSamples = 40000;
-    double s[2] = {0.0, 0.0};
-    double s2[2] = {0.0, 0.0};
-    for (int i = 0; i < kSamples; ++i) {
-      const double uni = walk.estimate(c.wi, c.wo, rng);
-      const double bi = walk.estimate_bidirectional(c.wi, c.wo, rng);
-      s[0] += uni;
-      s2[0] += uni * uni;
-      s[1] += bi;
-      s2[1] += bi * bi;
-    }
-    const double m0 = s[0] / kSamples;
-    const double m1 = s[1] / kSamples;
-    const double v0 = (s2[0] / kSamples - m0 * m0) / kSamples;
-    const double v1 = (s2[1] / kSamples - m1 * m1) / kSamples;
+    const auto [m0, v0, m1, v1] = both_estimators(walk, c.wi, c.wo, 53);
     std::printf("dielectric alpha %.1f %s: unidirectional %.6f +- %.6f, bidirectional %.6f +- %.6f\n", c.alpha,
                 (c.wo.z > 0.0) == (c.wi.z > 0.0) ? "R" : "T", m0, std::sqrt(v0), m1, std::sqrt(v1));
     EXPECT_GT(m0, 0.0);

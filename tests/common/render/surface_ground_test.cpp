@@ -94,29 +94,34 @@ TEST(SurfaceGround, SmoothWaterShowsTheSunTimesItsFresnelReflectance) {
   for (double L : off.radiance[0]) EXPECT_LT(L, 1e-6 * Le[0]);
 }
 
-// L(wo) = L_sun * integral over the sun's cone of f(wo, wi) cos(theta_i)
-// dwi, by a polar midpoint rule on the cone (64 x 64; the disk is
-// uniform), with the BSDF's own deterministic f.
-double glint_by_quadrature(const material::Bsdf& bsdf, const Frame& frame, const glm::dvec3& wo_local,
-                           const Sun& sun, double Le) {
-  constexpr int kRings = 64, kSectors = 64;
+// The integral over the sun's cone of g(wi) dwi, wi in the ground's local
+// frame, by a polar midpoint rule on the cone (the disk is uniform).
+template <class G>
+double integral_over_the_disk(const Sun& sun, const Frame& frame, int rings, int sectors, G&& g) {
   const double alpha = sun.angular_radius_rad();
   const Frame cone(sun.direction());
-  material::RandomSequence unused(0);
   double sum = 0.0;
-  for (int a = 0; a < kRings; ++a) {
-    const double theta = (a + 0.5) / kRings * alpha;
-    for (int b = 0; b < kSectors; ++b) {
-      const double phi = (b + 0.5) / kSectors * 2.0 * kPi;
-      const glm::dvec3 wi = cone.to_world(
-          {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
-      const glm::dvec3 wi_local = frame.to_local(wi);
-      if (wi_local.z <= 0.0) continue;
-      sum += bsdf.f(wo_local, wi_local, unused) * wi_local.z * std::sin(theta) * (alpha / kRings) *
-             (2.0 * kPi / kSectors);
+  for (int a = 0; a < rings; ++a) {
+    const double theta = (a + 0.5) / rings * alpha;
+    for (int b = 0; b < sectors; ++b) {
+      const double phi = (b + 0.5) / sectors * 2.0 * kPi;
+      const glm::dvec3 wi = frame.to_local(
+          cone.to_world({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}));
+      if (wi.z <= 0.0) continue;
+      sum += g(wi) * std::sin(theta) * (alpha / rings) * (2.0 * kPi / sectors);
     }
   }
-  return Le * sum;
+  return sum;
+}
+
+// L(wo) = L_sun * integral over the sun's cone of f(wo, wi) cos(theta_i)
+// dwi (64 x 64 nodes), with the BSDF's own deterministic f.
+double glint_by_quadrature(const material::Bsdf& bsdf, const Frame& frame, const glm::dvec3& wo_local,
+                           const Sun& sun, double Le) {
+  material::RandomSequence unused(0);
+  return Le * integral_over_the_disk(sun, frame, 64, 64, [&](const glm::dvec3& wi) {
+           return bsdf.f(wo_local, wi, unused) * wi.z;
+         });
 }
 
 // The same with the multiple-bounce gold, whose f is a random estimate: the
@@ -134,26 +139,17 @@ TEST(SurfaceGround, MultipleBounceGoldGlintMatchesItsAveragedEstimateOverTheDisk
   const glm::dvec3 n = ground_normal_seen(scene, view);
   const Frame frame(n);
   const SampledSpectrum Le = sun_radiance(scene, lambdas);
-  constexpr int kRings = 16, kSectors = 32, kRepeats = 16;
-  const double disk = scene.sun().angular_radius_rad();
-  const Frame cone(scene.sun().direction());
+  constexpr int kRepeats = 16;
   for (std::size_t w = 0; w < lambdas.size(); ++w) {
     const material::SurfaceBsdf bsdf = scene.ground_surface()->bsdf(lambdas[w]);
     // Isotropic: any tangent frame about n gives the same values.
     const glm::dvec3 wo = frame.to_local(-view);
     material::RandomSequence rng(77);
-    double sum = 0.0;
-    for (int a = 0; a < kRings; ++a) {
-      const double theta = (a + 0.5) / kRings * disk;
-      for (int b = 0; b < kSectors; ++b) {
-        const double phi = (b + 0.5) / kSectors * 2.0 * kPi;
-        const glm::dvec3 wi = frame.to_local(
-            cone.to_world({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)}));
-        double f = 0.0;
-        for (int k = 0; k < kRepeats; ++k) f += bsdf.get().f(wi, wo, rng) / kRepeats;
-        sum += f * wi.z * std::sin(theta) * (disk / kRings) * (2.0 * kPi / kSectors);
-      }
-    }
+    const double sum = integral_over_the_disk(scene.sun(), frame, 16, 32, [&](const glm::dvec3& wi) {
+      double f = 0.0;
+      for (int k = 0; k < kRepeats; ++k) f += bsdf.get().f(wi, wo, rng) / kRepeats;
+      return f * wi.z;
+    });
     const double expected = Le[static_cast<int>(w)] * sum;
     ASSERT_GT(expected, 0.0);
     EXPECT_NEAR(r.radiance[0][w], expected, 4.0 * r.standard_error[0][w] + 0.01 * expected) << lambdas[w] << " nm";
