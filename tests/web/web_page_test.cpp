@@ -109,6 +109,11 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   driver.type("#height", "16");
   driver.type("#spp", "256");
   driver.execute("document.querySelector('#adaptive').click();");  // variance-aware sample allocation
+  // A lake: water with a light ripple (the roughness input opens with the material).
+  EXPECT_TRUE(driver.execute("return document.querySelector('#ground-roughness').disabled;").get<bool>());
+  set_value(driver, "#ground-material", "water");
+  EXPECT_FALSE(driver.execute("return document.querySelector('#ground-roughness').disabled;").get<bool>());
+  driver.type("#ground-roughness", "0.05");
   driver.send_keys(driver.find("#spp"), "\xEE\x80\x87");  // U+E007 Enter: the keyboard submits the form
 
   const bool shown = driver.wait_until(
@@ -145,6 +150,8 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   const nlohmann::json status = server.status(id);
   EXPECT_EQ(status["state"], "done") << status.dump();
   EXPECT_EQ(status["plan"]["adaptive"], true) << "the checkbox asked for it";
+  EXPECT_EQ(status["plan"]["ground"]["material"], "water") << status["plan"].dump();
+  EXPECT_EQ(status["plan"]["ground"]["roughness"], nlohmann::json::array({0.05, 0.05}));
   EXPECT_NEAR(status["progress"]["samples_per_pixel"].get<double>(), 256.0, 4.0) << "the mean over the pixels";
 
   // The render list (refreshed by the page) has the job, done; the worker list a worker.

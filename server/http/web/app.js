@@ -298,6 +298,7 @@ async function submitForm(event) {
 function updateFormMode() {
   document.body.dataset.kind = kind();
   $("#fov").disabled = $("#projection").value === "equirectangular";
+  $("#ground-roughness").disabled = $("#ground-material").value === "";  // the default ground has none
   try {
     $("#time-preview").value = isoWithOffset($("#time-local").value, $("#time-zone").value);
   } catch (error) {
