@@ -5,6 +5,7 @@
 //   atmosphere            planet, shell, constituents, ground (Lambertian: its albedo)
 //   ground_surface        the ground's material when it is not Lambertian
 //                         (null otherwise: a plain ground pays nothing new)
+//   objects               surfaces in the air (null: none, and none of their cost)
 //   sun                   position, disk, irradiance
 //   observer_altitude_m   the camera / probe position above the ground (on +z)
 //   lambda_min/max_nm     the wavelengths paths may carry (majorants cover them)
@@ -21,6 +22,7 @@
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/material/surface.h"
 #include "common/render/atmosphere_medium.h"
+#include "common/render/scene_objects.h"
 #include "common/sun/sun.h"
 
 namespace skyfarm {
@@ -36,6 +38,9 @@ class Scene {
   const Sun& sun() const { return sun_; }
   // The ground's BSDF when it is not Lambertian, else null.
   const material::Surface* ground_surface() const { return ground_surface_.get(); }
+  // The objects in the scene, or null.
+  const SceneObjects* objects() const { return objects_.get(); }
+  void set_objects(std::shared_ptr<const SceneObjects> objects) { objects_ = std::move(objects); }
   // Planet-centred observer position (0, 0, R + altitude).
   glm::dvec3 observer() const { return observer_; }
   double observer_altitude_m() const { return observer_.z - atmosphere_->planet_radius_m(); }
@@ -49,6 +54,7 @@ class Scene {
   std::unique_ptr<Atmosphere> atmosphere_;
   std::unique_ptr<AtmosphereMedium> medium_;
   std::shared_ptr<const material::Surface> ground_surface_;
+  std::shared_ptr<const SceneObjects> objects_;
   Sun sun_;
   glm::dvec3 observer_;
   double lambda_min_, lambda_max_;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <optional>
 
 #include <glm/geometric.hpp>
@@ -37,6 +38,7 @@ struct VolumePathIntegrator::RayExtent {
   bool in_atmosphere = false;
   double t_begin = 0.0, t_end = 0.0;
   bool hits_ground = false;
+  std::optional<SurfaceHit> object;  // an object before the ground or space (then t_end is its t)
 };
 
 namespace {
@@ -79,6 +81,19 @@ Frame ground_frame(const glm::dvec3& n) {
   Frame f;
   f.n = n;
   f.s = east / length;
+  f.t = glm::cross(n, f.s);
+  return f;
+}
+
+// An object's frame at the unit normal n (the side the ray came from): s
+// along its tangent made perpendicular to n.
+Frame surface_frame(const glm::dvec3& n, const glm::dvec3& tangent) {
+  const glm::dvec3 s = tangent - glm::dot(tangent, n) * n;
+  const double length = glm::length(s);
+  if (!(length > 1e-12)) return Frame(n);
+  Frame f;
+  f.n = n;
+  f.s = s / length;
   f.t = glm::cross(n, f.s);
   return f;
 }
@@ -172,7 +187,13 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
 
   for (;; ++depth) {
     const RadialRay radial = radial_ray(ray);
-    const RayExtent extent = ray_extent(radial, atmosphere);
+    RayExtent extent = ray_extent(radial, atmosphere);
+    if (scene_.objects() && extent.in_atmosphere) {
+      if ((extent.object = scene_.objects()->intersect(ray, extent.t_end))) {
+        extent.t_end = extent.object->t;
+        extent.hits_ground = false;
+      }
+    }
     bool scattered = false, absorbed = false;
     // --- The sun scattered once along this segment, sampled where it is lit:
     // on segments the planet's shadow cuts or that start with the sun below
@@ -412,6 +433,13 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const Sun& sun = scene_.sun();
   const PathCoefficients& path = c.path;
   if (st->beta.is_zero()) return false;
+  if (extent.object) {
+    // Two-sided: the side the ray came from.
+    const SurfaceHit& hit = *extent.object;
+    const glm::dvec3 n = glm::dot(hit.n, ray->d) < 0.0 ? hit.n : -hit.n;
+    return bounce_on_surface(*hit.surface, hit.p + n * hit.offset_m, surface_frame(n, hit.tangent), c, depth, ray,
+                             st, L);
+  }
   if (!extent.hits_ground) {
     const bool sun_is_segment_estimators = st->sun_from_segment_estimator;
     if (scene_.sun_enabled && sun.contains(ray->d) && !sun_is_segment_estimators) {
@@ -427,7 +455,11 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
       *L += st->beta * scene_.environment_radiance * (1.0 / st->r_u.average());
     return false;
   }
-  if (scene_.ground_surface()) return bounce_on_surface(extent, c, depth, ray, st, L);
+  if (scene_.ground_surface()) {
+    const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
+    return bounce_on_surface(*scene_.ground_surface(), n * (scene_.atmosphere().planet_radius_m() + kGroundOffset_m),
+                             ground_frame(n), c, depth, ray, st, L);
+  }
   // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
   const Atmosphere& atmosphere = scene_.atmosphere();
   const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
@@ -465,14 +497,13 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // to the camera, as any closed isothermal scene must.  The reciprocal forms
 // (Lambertian, single-bounce conductor, the smooth reflector, dielectric
 // reflection) are unchanged by the swap.
-bool VolumePathIntegrator::bounce_on_surface(const RayExtent& extent, const PathContext& c, int depth, Ray* ray,
-                                             PathState* st, SampledSpectrum* L) const {
-  const material::Surface& surface = *scene_.ground_surface();
+bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, const glm::dvec3& p, const Frame& frame,
+                                             const PathContext& c, int depth, Ray* ray, PathState* st,
+                                             SampledSpectrum* L) const {
   const Sun& sun = scene_.sun();
-  const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
-  const glm::dvec3 p = n * (scene_.atmosphere().planet_radius_m() + kGroundOffset_m);
+  const glm::dvec3& n = frame.n;
   SurfaceVertex sv;
-  sv.frame = ground_frame(n);
+  sv.frame = frame;
   sv.wo = sv.frame.to_local(-ray->d);
   if (!(sv.wo.z > 0.0)) return false;
   for (int i = 0; i < kWavelengthsPerPath; ++i) sv.bsdf[i] = surface.bsdf(c.lambda.lambda_nm[i]);
@@ -621,6 +652,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   const Ray shadow{v.p, wi};
   const RadialRay radial = radial_ray(shadow);  // shared by the ground, the top and the shells
   if (ground_distance(radial, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
+  if (scene_.objects() && scene_.objects()->occluded(shadow, std::numeric_limits<double>::infinity()))
+    return SampledSpectrum(0.0);
   const SphereHit top = intersect_sphere(radial, atmosphere.top_radius_m());
   SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
   if (top.hit && top.t_far > 0.0 && options_.residual_ratio_tracking &&
@@ -717,6 +750,7 @@ VolumePathIntegrator::SunlitSample VolumePathIntegrator::sunlit_single_scatterin
   const glm::dvec3 wi = scene_.sun().sample_direction(u_s1, u_s2, &pdf_light);
   const Ray to_sun{x, wi};
   if (ground_distance(to_sun, R) >= 0.0) return none;
+  if (scene_.objects() && scene_.objects()->occluded(to_sun, std::numeric_limits<double>::infinity())) return none;
   const SampledSpectrum p = mixture_phase(mp, phases, clamp_cos(glm::dot(ray.d, wi)));
   const TrackedTransmittance T_cam = tracked_transmittance(ray, t, path, sampler, counters);
   const TrackedTransmittance T_sun = tracked_transmittance(to_sun, 1e300, path, sampler, counters);

@@ -40,6 +40,7 @@
 #include "common/render/scene.h"
 #include "common/render/sunlit_intervals.h"
 #include "common/sampling/sampler.h"
+#include "common/sampling/warps.h"
 #include "common/spectrum/sampled_spectrum.h"
 
 namespace skyfarm {
@@ -210,10 +211,11 @@ class VolumePathIntegrator {
                          Ray* ray, PathState* st) const;
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
-  // The ground when it is a material (Scene::ground_surface): like
-  // finish_segment's ground branch, with the surface's BSDF.
-  bool bounce_on_surface(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
-                         SampledSpectrum* L) const;
+  // A surface that is a material (the ground's when it is not Lambertian, an
+  // object's) at p (already off the surface on the ray's side), its local
+  // frame's z the normal on that side: sun NEE, then the next direction.
+  bool bounce_on_surface(const material::Surface& surface, const glm::dvec3& p, const Frame& frame,
+                         const PathContext& c, int depth, Ray* ray, PathState* st, SampledSpectrum* L) const;
   // Russian roulette after the vertex at p whose next direction is wi (the
   // control variate adds to *L, the light this path has gathered so far).
   bool survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth, const PathContext& c,

@@ -1,0 +1,166 @@
+// Objects in the path tracer (Scene::objects), against closed forms: a
+// white Lambertian sphere lit by the sun's disk in vacuum, the same sphere
+// in a white furnace, and a sphere's shadow.  The spheres are the analytic
+// test objects of tests/support/analytic_spheres.h.  Tolerances: 4 standard
+// errors unless stated.
+#include <gtest/gtest.h>
+
+#include "tests/support/analytic_spheres.h"
+#include "tests/support/sun_specs.h"
+#include "tests/support/thin_layer.h"
+
+#include <cmath>
+#include <memory>
+
+#include <glm/geometric.hpp>
+
+#include "common/core/constants.h"
+#include "common/material/surface.h"
+#include "common/render/radiance_probe.h"
+#include "common/render/volume_path_integrator.h"
+
+namespace skyfarm {
+namespace {
+
+material::SurfaceSpec white_lambertian(double albedo) {
+  material::SurfaceSpec s;
+  s.name = "white";
+  s.custom = true;
+  s.kind = material::MaterialKind::kDiffuse;
+  s.wavelengths_nm = {300.0, 900.0};
+  s.albedo = {albedo, albedo};
+  return s;
+}
+
+// Where the ray from the observer along d meets the sphere (centre c,
+// radius r, in the observer's frame): the outward normal there.
+std::optional<glm::dvec3> normal_seen(const glm::dvec3& d, const glm::dvec3& c, double r) {
+  const double b = glm::dot(-c, d), q = glm::dot(c, c) - r * r, disc = b * b - q;
+  if (disc < 0.0) return std::nullopt;
+  const double t = -b - std::sqrt(disc);
+  return glm::normalize(t * d - c);
+}
+
+// A Lambertian sphere of albedo rho under a uniform sun disk of radius alpha
+// and radiance L_sun, nothing else: L = (rho / pi) integral_disk n.w L_sun dw
+// = rho L_sun sin^2(alpha) (n.s), the disk wholly above the tangent plane
+// (the mean of w over a cone of half-angle alpha is s (1 + cos alpha) / 2
+// times its solid angle 2 pi (1 - cos alpha)).  On the far side: 0.
+TEST(ObjectTransport, LambertianSphereUnderTheSunInVacuumIsRhoLSunSin2AlphaCos) {
+  const double rho = 0.8, sun_zenith = 40.0;
+  const Location at{0, 0, 1.5};
+  Scene scene = Scene::from_specs(testing::thin_hg_layer(1e-12, 1000.0, 0.0), testing::sun_spec(sun_zenith, 90.0),
+                                  at, std::nullopt, 360.0, 830.0);
+  const material::Surface white(white_lambertian(rho));
+  const glm::dvec3 centre(0.0, 6.0, 0.5);  // 6 m north, its top 1.5 m up
+  const double radius = 1.0;
+  scene.set_objects(std::make_shared<testing::AnalyticSpheres>(
+      scene.observer(), std::vector<testing::AnalyticSpheres::Sphere>{{centre, radius, &white}}));
+  const glm::dvec3 s = scene.sun().direction();
+  SampledWavelengths wl;
+  wl.lambda_nm = {450.0, 550.0, 650.0, 750.0};
+  wl.pdf.fill(1.0);
+  const SampledSpectrum Le = scene.medium().path_coefficients(wl, &scene.sun()).sun_radiance;
+  const double sin_alpha = std::sin(scene.sun().angular_radius_rad());
+  // Directions over the sphere's face, lit and unlit.
+  std::vector<glm::dvec3> dirs;
+  for (double dx : {-0.12, -0.06, 0.0, 0.06, 0.12})
+    for (double dz : {-0.1, 0.0, 0.1}) dirs.push_back(glm::normalize(centre + glm::dvec3(dx * 6, 0, dz * 6)));
+  const ProbeResult r = probe_radiance(scene, dirs, {450.0, 550.0, 650.0, 750.0}, 256, 7, 2);
+  EXPECT_EQ(r.counters.nonfinite, 0u);
+  int lit = 0, dark = 0;
+  for (std::size_t d = 0; d < dirs.size(); ++d) {
+    const auto n = normal_seen(dirs[d], centre, radius);
+    ASSERT_TRUE(n) << d;
+    const double cos_s = glm::dot(*n, s);
+    // Only where the whole disk is on one side of the tangent plane.
+    if (std::abs(cos_s) < 2.0 * sin_alpha) continue;
+    for (std::size_t w = 0; w < 4; ++w) {
+      const double expected = cos_s > 0.0 ? rho * Le[static_cast<int>(w)] * sin_alpha * sin_alpha * cos_s : 0.0;
+      EXPECT_NEAR(r.radiance[d][w], expected, 4.0 * r.standard_error[d][w] + 1e-6 * Le[0] * sin_alpha * sin_alpha)
+          << "direction " << d << " cos " << cos_s;
+    }
+    (cos_s > 0.0 ? lit : dark) += 1;
+  }
+  EXPECT_GT(lit, 3);
+  EXPECT_GT(dark, 1);
+}
+
+// A white sphere on a white ground under a uniform sky of radiance 1, in a
+// conservative atmosphere: every surface and the air keep all the light,
+// so every direction sees radiance 1, the sphere's included.
+TEST(ObjectTransport, WhiteSphereInTheFurnaceHasTheEnvironmentsRadiance) {
+  AtmosphereSpec spec = testing::thin_hg_layer(2e-5, 8000.0, 0.6);
+  spec.ground_albedo = 1.0;
+  Scene scene = Scene::from_specs(spec, testing::sun_spec(30.0, 0.0), Location{0, 0, 1.0}, std::nullopt, 400.0, 700.0);
+  scene.sun_enabled = false;
+  scene.environment_radiance = 1.0;
+  const material::Surface white(white_lambertian(1.0));
+  const glm::dvec3 centre(0.0, 4.0, 0.0);
+  scene.set_objects(std::make_shared<testing::AnalyticSpheres>(
+      scene.observer(), std::vector<testing::AnalyticSpheres::Sphere>{{centre, 1.0, &white}}));
+  const std::vector<glm::dvec3> dirs = {glm::normalize(centre), glm::normalize(centre + glm::dvec3(0.5, 0, 0.5)),
+                                        glm::normalize(centre + glm::dvec3(0, 0, -0.8)),
+                                        direction_from_zenith_azimuth(0.3, 2.0)};
+  const ProbeResult r = probe_radiance(scene, dirs, {420.0, 650.0}, 4096, 3, 2);
+  EXPECT_EQ(r.counters.nonfinite, 0u);
+  for (std::size_t d = 0; d < dirs.size(); ++d)
+    for (std::size_t w = 0; w < 2; ++w)
+      EXPECT_NEAR(r.radiance[d][w], 1.0, 4.0 * r.standard_error[d][w] + 1e-9) << "direction " << d;
+}
+
+// The area of the intersection of two disks of radii r1, r2 whose centres
+// are d apart (the lens formula).
+double lens_area(double r1, double r2, double d) {
+  if (d >= r1 + r2) return 0.0;
+  if (d <= std::abs(r1 - r2)) return kPi * std::min(r1, r2) * std::min(r1, r2);
+  const double a1 = r1 * r1 * std::acos((d * d + r1 * r1 - r2 * r2) / (2.0 * d * r1));
+  const double a2 = r2 * r2 * std::acos((d * d + r2 * r2 - r1 * r1) / (2.0 * d * r2));
+  return a1 + a2 - 0.5 * std::sqrt((-d + r1 + r2) * (d + r1 - r2) * (d - r1 + r2) * (d + r1 + r2));
+}
+
+// A black sphere's shadow on a white Lambertian ground in vacuum, the sun at
+// the zenith.  A ground point sees the sun's disk (angular radius alpha)
+// partly covered by the sphere's (angular radius asin(r / D) at angular
+// distance atan(x / h) from the zenith, D the distance to the centre): its
+// radiance is rho L_sun sin^2(alpha) times the uncovered fraction of the
+// disk, by the lens formula (small angles: the disks are flat, and cos
+// across the disk is 1 within 1e-5).  Umbra under the centre, the
+// penumbra's two sides, open ground.
+TEST(ObjectTransport, SphereShadowHasTheUmbraAndPenumbraOfTheSunsDisk) {
+  const double rho = 1.0;
+  AtmosphereSpec spec = testing::thin_hg_layer(1e-12, 1000.0, 0.0);
+  spec.ground_albedo = rho;
+  Scene scene = Scene::from_specs(spec, testing::sun_spec(0.0, 0.0), Location{0, 0, 3.0}, std::nullopt, 360.0, 830.0);
+  const material::Surface black(white_lambertian(0.0));
+  // A 0.5 m sphere 100 m above the ground point 10 m north: the penumbra
+  // is 2 alpha h = 0.93 m wide around the shadow's 0.5 m edge.
+  const double h = 100.0, radius = 0.5;
+  const glm::dvec3 centre(0.0, 10.0, h - 3.0);
+  scene.set_objects(std::make_shared<testing::AnalyticSpheres>(
+      scene.observer(), std::vector<testing::AnalyticSpheres::Sphere>{{centre, radius, &black}}));
+  SampledWavelengths wl;
+  wl.lambda_nm = {550.0, 550.0, 550.0, 550.0};
+  wl.pdf.fill(1.0);
+  const double Le = scene.medium().path_coefficients(wl, &scene.sun()).sun_radiance[0];
+  const double alpha = scene.sun().angular_radius_rad();
+  const double open = rho * Le * std::sin(alpha) * std::sin(alpha);
+  const std::vector<double> xs = {0.0, 0.3, 0.5, 0.75, 3.0};  // east of the shadow's centre, m
+  std::vector<glm::dvec3> dirs;
+  for (double x : xs) dirs.push_back(glm::normalize(glm::dvec3(x, 10.0, -3.0)));
+  const ProbeResult r = probe_radiance(scene, dirs, {550.0}, 8192, 11, 2);
+  EXPECT_EQ(r.counters.nonfinite, 0u);
+  int in_penumbra = 0;
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    const double covered = lens_area(alpha, std::asin(radius / std::hypot(h, xs[i])), std::atan(xs[i] / h)) /
+                           (kPi * alpha * alpha);
+    const double expected = open * (1.0 - covered);
+    if (covered > 0.05 && covered < 0.95) ++in_penumbra;
+    EXPECT_NEAR(r.radiance[i][0], expected, 4.0 * r.standard_error[i][0] + 2e-3 * open)
+        << "x " << xs[i] << " m, covered " << covered;
+  }
+  EXPECT_GE(in_penumbra, 2);
+}
+
+}  // namespace
+}  // namespace skyfarm
