@@ -15,6 +15,7 @@
 #include <glm/geometric.hpp>
 
 #include "common/core/constants.h"
+#include "common/material/fresnel.h"
 #include "common/material/surface.h"
 #include "common/render/radiance_probe.h"
 #include "common/render/volume_path_integrator.h"
@@ -107,6 +108,51 @@ TEST(ObjectTransport, WhiteSphereInTheFurnaceHasTheEnvironmentsRadiance) {
   for (std::size_t d = 0; d < dirs.size(); ++d)
     for (std::size_t w = 0; w < 2; ++w)
       EXPECT_NEAR(r.radiance[d][w], 1.0, 4.0 * r.standard_error[d][w] + 1e-9) << "direction " << d;
+}
+
+// A chrome ball is a light probe: a smooth conductor sphere shows in each
+// pixel the sky of the mirror direction times the Fresnel reflectance at
+// that angle.  The sky there is probed independently from the observer
+// (the ball is 5 m away: the sky's radiance does not change over 5 m); the
+// two estimates agree within 4 combined standard errors.  Earth's air, the
+// sun well away from the mirrored directions.
+TEST(ObjectTransport, ChromeBallReflectsTheSkyOfTheMirrorDirection) {
+  AtmosphereSpec spec;  // earth
+  Scene scene = Scene::from_specs(spec, testing::sun_spec(50.0, 90.0), Location{0, 0, 1.5}, std::nullopt, 360.0, 830.0);
+  material::SurfaceSpec chrome;
+  chrome.name = "chrome";
+  chrome.custom = true;
+  chrome.kind = material::MaterialKind::kConductor;
+  chrome.wavelengths_nm = {300.0, 900.0};
+  chrome.n = {2.5, 2.5};
+  chrome.k = {3.5, 3.5};
+  const material::Surface ball(chrome);
+  const glm::dvec3 centre(0.0, 5.0, 0.0);
+  const double radius = 0.5;
+  scene.set_objects(std::make_shared<testing::AnalyticSpheres>(
+      scene.observer(), std::vector<testing::AnalyticSpheres::Sphere>{{centre, radius, &ball}}));
+  std::vector<glm::dvec3> on_ball, mirrored;
+  std::vector<double> fresnel;
+  for (double dx : {-0.05, 0.0, 0.05})
+    for (double dz : {0.03, 0.06}) {
+      const glm::dvec3 d = glm::normalize(centre + glm::dvec3(dx * 5, 0, dz * 5));
+      const auto n = normal_seen(d, centre, radius);
+      ASSERT_TRUE(n);
+      const glm::dvec3 m = d - 2.0 * glm::dot(d, *n) * *n;
+      if (m.z < 0.1) continue;  // the sky only
+      on_ball.push_back(d);
+      mirrored.push_back(m);
+      fresnel.push_back(material::fresnel_conductor(-glm::dot(d, *n), {2.5, 3.5}));
+    }
+  ASSERT_GE(on_ball.size(), 3u);
+  const ProbeResult seen = probe_radiance(scene, on_ball, {450.0, 600.0}, 2048, 13, 2);
+  const ProbeResult sky = probe_radiance(scene, mirrored, {450.0, 600.0}, 2048, 17, 2);
+  for (std::size_t d = 0; d < on_ball.size(); ++d)
+    for (std::size_t w = 0; w < 2; ++w) {
+      const double expected = fresnel[d] * sky.radiance[d][w];
+      const double se = std::hypot(seen.standard_error[d][w], fresnel[d] * sky.standard_error[d][w]);
+      EXPECT_NEAR(seen.radiance[d][w], expected, 4.0 * se) << "direction " << d << ", F " << fresnel[d];
+    }
 }
 
 // The area of the intersection of two disks of radii r1, r2 whose centres
