@@ -508,7 +508,8 @@ bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, c
   if (!(sv.wo.z > 0.0)) return false;
   for (int i = 0; i < kWavelengthsPerPath; ++i) sv.bsdf[i] = surface.bsdf(c.lambda.lambda_nm[i]);
   const bool specular = sv.bsdf[0].specular();
-  if (scene_.sun_enabled && !specular) {
+  const SurfaceSunSampling strategy = options_.surface_sun_sampling;
+  if (scene_.sun_enabled && !specular && strategy != SurfaceSunSampling::kBsdfOnly) {
     const Vertex v{p, ray->d, true, n, nullptr, nullptr, &c.path, &c.coarse, st->beta, st->r_u, &sv};
     *L += sample_sun(v, c.lambda, c.sampler, c.counters);
   }
@@ -537,9 +538,10 @@ bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, c
     st->r_l = st->r_u * (1.0 / pdf_hero);
     st->beta *= f * (wi.z / pdf_hero);
     st->r_u *= pdf * (1.0 / pdf_hero);
-    st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
+    st->mis_with_sun = scene_.sun_enabled && !sun.is_point() && strategy == SurfaceSunSampling::kMis;
   }
-  st->sun_from_segment_estimator = false;
+  // Sun only: the disk met by the BSDF's direction is NEE's alone.
+  st->sun_from_segment_estimator = strategy == SurfaceSunSampling::kSunOnly && !specular;
   const glm::dvec3 wi_world = glm::normalize(sv.frame.to_world(wi));
   *ray = Ray{p, wi_world};
   return survives(st, p, wi_world, depth, c, L);
@@ -702,7 +704,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   const SampledSpectrum& Le = v.path->sun_radiance;
   const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
   const SampledSpectrum Ld = v.beta * f * T_ray * Le;
-  if (sun.is_point()) return Ld * (1.0 / r_l.average());
+  if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
+    return Ld * (1.0 / r_l.average());
   const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
   return Ld * (1.0 / (r_l + r_u).average());
 }

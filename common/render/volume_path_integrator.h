@@ -49,8 +49,14 @@ class PathMajorants;
 class RadianceControl;
 class ShadowGuide;
 
+// How the sun's light reaches a surface vertex (a material ground, an
+// object): by next-event estimation and BSDF sampling combined by MIS (the
+// renderer's), or by one of them alone (the MIS tests compare the three).
+enum class SurfaceSunSampling { kMis, kSunOnly, kBsdfOnly };
+
 struct IntegratorOptions {
   int max_depth = 10000;
+  SurfaceSunSampling surface_sun_sampling = SurfaceSunSampling::kMis;
   int rr_start_depth = 2;
   // Russian roulette plays on a throughput below this at vertices in the
   // planet's shadow (1 elsewhere), and survivors carry it: a twilight path
