@@ -24,6 +24,14 @@ float float_up(double x) {
   return f;
 }
 
+// The largest float not above x.
+float float_down(double x) {
+  if (x <= -static_cast<double>(std::numeric_limits<float>::max())) return -std::numeric_limits<float>::infinity();
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
 // Relative and absolute slack between Embree's float t and the double t.
 constexpr double kRelativeSlack = 1e-5;
 
@@ -86,23 +94,27 @@ struct Query {
   glm::dvec3 origin;
   glm::dvec3 dir;
   double tmax;
+  bool collect = false;  // closest hit's second pass: reject all, keep the best
   std::optional<BvhHit> best;
 };
 
-// Closest hit: every candidate is rejected for Embree and kept here when it
-// beats the best so far in doubles; the ray's float tfar then shrinks to the
-// best t plus slack, which prunes the rest of the traversal.
+// Closest hit, in two passes over the same filter.  The first (collect
+// false) lets Embree commit every candidate the double test confirms, so its
+// float tfar shrinks as usual and the traversal ends at the float-closest
+// confirmed hit (a filter that rejects everything and lowers tfar itself does
+// not prune: Embree 3 does not re-read tfar after a rejected hit).  The true
+// closest in doubles lies within the float error of that hit, so the second
+// pass (collect true) walks only the window t_found +- slack, rejects every
+// candidate for Embree and keeps the smallest (t, instance, primitive) here.
 void closest_filter(const RTCFilterFunctionNArguments* args) {
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] == 0) continue;
-    args->valid[i] = 0;
     auto* q = reinterpret_cast<Query*>(args->context);
     const std::uint32_t instance = args->context->instID[0];
     const std::uint32_t primitive = RTCHitN_primID(args->hit, args->N, i);
     const auto hit = q->impl->refine(instance, primitive, q->origin, q->dir, q->tmax);
-    if (!hit || (q->best && !key_less(*hit, *q->best))) continue;
-    q->best = hit;
-    RTCRayN_tfar(args->ray, args->N, i) = float_up(hit->t + q->impl->slack(hit->t));
+    if (!hit || q->collect) args->valid[i] = 0;
+    if (hit && (!q->best || key_less(*hit, *q->best))) q->best = hit;
   }
 }
 
@@ -239,6 +251,18 @@ std::optional<BvhHit> TriangleBvh::closest_hit(const glm::dvec3& origin, const g
   set_ray(rh.ray, origin, dir, float_up(tmax + s.slack(tmax)));
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcIntersect1(s.top, &q.context, &rh);
+  if (!q.best) return std::nullopt;
+  // The window pass.  Its bounds come from the found hit's double t; every
+  // triangle whose double t is within the float error of it has its float t
+  // inside the window.
+  const double t = q.best->t, slack = s.slack(t);
+  set_ray(rh.ray, origin, dir, float_up(std::min(t + slack, tmax + slack)));
+  rh.ray.tnear = std::max(0.0f, float_down(t - slack));
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  rtcInitIntersectContext(&q.context);
+  q.collect = true;
   rtcIntersect1(s.top, &q.context, &rh);
   return q.best;
 }

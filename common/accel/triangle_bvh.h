@@ -20,15 +20,17 @@
 //   inverse transform) and that test alone decides t, u, v and the hit point
 //   (origin + t * dir, in doubles).  The closest hit is the smallest
 //   (t, instance, primitive) among the candidates, so exact ties go to the
-//   lowest ids whatever the BVH's shape or traversal order.  Candidates are
-//   searched up to t_best * (1 + 1e-5) + 1e-5 * extent (extent: the largest
-//   coordinate magnitude of the scene's world bounds), so a triangle whose
-//   double t beats the best is not lost to Embree's float t being a little
-//   larger.  What the float traversal can still miss: a ray that crosses a
-//   triangle within about one float ulp of its edge (float says outside,
-//   double says inside), for scenes within ~20 km of the origin a band of a
-//   few millimetres around edges hit at grazing angles; shared edges of a
-//   mesh stay closed (both triangles use the same float vertices).
+//   lowest ids whatever the BVH's shape or traversal order.  Two passes: the
+//   float-closest confirmed hit, then every candidate within a window of
+//   1e-5 * (t + extent) around its double t (extent: the largest coordinate
+//   magnitude of the scene's world bounds), so a triangle whose double t
+//   beats it is not lost to Embree's float t being a little larger.
+//   What the float traversal can still miss: a ray that crosses a triangle
+//   within float rounding of its edge (float says outside, double inside), a
+//   band about 1e-7 of the coordinates wide (some 2 mm at 20 km; wider at
+//   grazing incidence).  Only there can the hit depend on the CPU Embree runs
+//   on (its SSE and AVX kernels round differently); shared edges of one mesh
+//   stay closed (both triangles use the same float vertices).
 //   Hits are counted for t in (0, tmax]; the caller offsets origins off the
 //   surface they leave.
 //
