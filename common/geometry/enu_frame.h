@@ -13,6 +13,10 @@
 // to_world(hit) adds that rounding to the hit's error bound, so spawn.h's
 // offset keeps a ray spawned in world coordinates on the correct side of
 // the surface (its offset is then ~1e-9 m instead of ~1e-13 m in ENU).
+// Rays from one object to another should still be spawned and carried in
+// ENU: with 1e-9 m offsets, a ray bounced deep into the crease where a
+// sphere rests on a plane starts under the plane once the gap there is
+// below the offset, and leaks; in ENU it does not.
 #pragma once
 #include <glm/vec3.hpp>
 
