@@ -13,6 +13,8 @@
 
 #include "common/core/constants.h"
 #include "common/geometry/enu_frame.h"
+#include "common/geometry/unit_disc.h"
+#include "common/geometry/unit_sphere.h"
 
 namespace skyfarm {
 namespace {
@@ -165,6 +167,24 @@ TEST(Placement, AreaScaleOfScaledSquareAndDisc) {
   const Transform t = transform_from_placement(pl);
   EXPECT_NEAR(t.area_scale({0, 0, 1}), 6.0, 1e-13);   // z = 0 plane: sx sy
   EXPECT_NEAR(t.area_scale({1, 0, 0}), 15.0, 1e-13);  // x = const: sy sz
+}
+
+TEST(Placement, AreaSamplesCarryTheirPdfPerPlacedArea) {
+  // A disc scaled into a 2 x 3 ellipse: pdf 1 / (6 pi) per m^2 everywhere.
+  Placement pl;
+  pl.rotate_deg = {40.0, 15.0, -5.0};
+  pl.scale = {2.0, 3.0, 0.5};
+  const Transform t = transform_from_placement(pl);
+  const AreaSample s = t.to_parent(sample_unit_disc({0.3, 0.8}));
+  EXPECT_NEAR(s.pdf_area, 1.0 / (6.0 * kPi), 1e-15);
+  expect_vec_near(s.n, t.normal({0, 0, 1}), 0.0);
+  // A sphere scaled by 2: 1 / (16 pi).
+  Placement ps;
+  ps.scale = glm::dvec3(2.0);
+  ps.translate_m = {1.0, 2.0, 3.0};
+  const AreaSample q = transform_from_placement(ps).to_parent(sample_unit_sphere({0.1, 0.7}));
+  EXPECT_NEAR(q.pdf_area, 1.0 / (16.0 * kPi), 1e-15);
+  EXPECT_NEAR(glm::length(q.p - glm::dvec3(1.0, 2.0, 3.0)), 2.0, 1e-15);
 }
 
 TEST(Placement, RejectsZeroOrNonFiniteScale) {
