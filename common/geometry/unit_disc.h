@@ -13,6 +13,7 @@
 #include <glm/vec2.hpp>
 #include <optional>
 
+#include "common/core/constants.h"
 #include "common/geometry/ray.h"
 #include "common/geometry/shape_hit.h"
 
@@ -20,6 +21,6 @@ namespace skyfarm {
 
 std::optional<ShapeHit> intersect_unit_disc(const Ray& ray, double t_max);
 AreaSample sample_unit_disc(const glm::dvec2& u);
-inline constexpr double kUnitDiscArea = 3.14159265358979323846;
+inline constexpr double kUnitDiscArea = kPi;
 
 }  // namespace skyfarm

@@ -14,6 +14,7 @@
 #include <glm/vec2.hpp>
 #include <optional>
 
+#include "common/core/constants.h"
 #include "common/geometry/ray.h"
 #include "common/geometry/shape_hit.h"
 
@@ -21,6 +22,6 @@ namespace skyfarm {
 
 std::optional<ShapeHit> intersect_unit_sphere(const Ray& ray, double t_max);
 AreaSample sample_unit_sphere(const glm::dvec2& u);
-inline constexpr double kUnitSphereArea = 4.0 * 3.14159265358979323846;
+inline constexpr double kUnitSphereArea = 4.0 * kPi;
 
 }  // namespace skyfarm
