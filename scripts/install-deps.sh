@@ -10,6 +10,7 @@ packages=(
   libopenexr-dev libimath-dev libglm-dev nlohmann-json3-dev libpng-dev
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsodium-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libassimp-dev               # mesh assets' import (common/assets/mesh_import.h)
   ffmpeg
   file                        # cpack -G DEB finds the programs' libraries with it
   yamllint python3-yaml       # the deployment files' tests (tests/deploy)

@@ -1,0 +1,153 @@
+#include "common/assets/mesh_import.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <exception>
+#include <vector>
+
+#include <assimp/BaseImporter.h>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+namespace skyfarm::assets {
+
+namespace {
+
+bool starts_with_ci(std::string_view text, std::string_view prefix) {
+  if (text.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(text[i])) != prefix[i]) return false;
+  return true;
+}
+
+std::string_view trim_front(std::string_view s) {
+  while (!s.empty() && (s.front() == ' ' || s.front() == '\t' || s.front() == '\r' || s.front() == '\n' ||
+                        s.front() == '\xEF' || s.front() == '\xBB' || s.front() == '\xBF'))
+    s.remove_prefix(1);
+  return s;
+}
+
+// assimp's extension for a format: the glTF 2 loader claims both.
+const char* extension_of(std::string_view format) {
+  if (format == "obj") return "obj";
+  if (format == "ply") return "ply";
+  if (format == "stl") return "stl";
+  if (format == "gltf") return "gltf";
+  if (format == "glb") return "glb";
+  return nullptr;
+}
+
+// Keeps only the loader of `extension` (the glTF 2.0 one for gltf/glb).
+void keep_one_loader(Assimp::Importer& importer, const char* extension) {
+  Assimp::BaseImporter* keep = importer.GetImporter(extension);
+  std::vector<Assimp::BaseImporter*> others;
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i)
+    if (Assimp::BaseImporter* loader = importer.GetImporter(i); loader != keep) others.push_back(loader);
+  for (Assimp::BaseImporter* loader : others) importer.UnregisterLoader(loader);
+}
+
+}  // namespace
+
+bool is_mesh_format(std::string_view format) {
+  return std::find(std::begin(kMeshFormats), std::end(kMeshFormats), format) != std::end(kMeshFormats);
+}
+
+std::optional<std::string> detect_mesh_format(std::string_view bytes) {
+  if (bytes.substr(0, 4) == "glTF") return "glb";
+  if (bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n") return "ply";
+  if (bytes.size() >= 84) {
+    std::uint32_t count;
+    std::memcpy(&count, bytes.data() + 80, 4);
+    if (bytes.size() == 84 + 50 * static_cast<std::uint64_t>(count)) return "stl";
+  }
+  const std::string_view text = trim_front(bytes);
+  if (starts_with_ci(text, "solid")) return "stl";
+  if (text.substr(0, 1) == "{" && bytes.find("\"asset\"") != std::string_view::npos) return "gltf";
+  if (text.substr(0, 2) == "v " || bytes.find("\nv ") != std::string_view::npos) return "obj";
+  return std::nullopt;
+}
+
+bool import_mesh(std::string_view bytes, std::string_view format, const MeshLimits& limits, TriangleMesh* mesh,
+                 std::string* error) {
+  const char* extension = extension_of(format);
+  if (!extension) {
+    *error = "unknown mesh format '" + std::string(format) + "'";
+    return false;
+  }
+  if (bytes.empty()) {
+    *error = "the mesh file is empty";
+    return false;
+  }
+  try {
+    Assimp::Importer importer;
+    keep_one_loader(importer, extension);
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                           aiProcess_PreTransformVertices | aiProcess_ValidateDataStructure;
+    const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), flags, extension);
+    if (!scene) {
+      *error = std::string("the ") + extension + " file could not be read: " + importer.GetErrorString();
+      return false;
+    }
+    std::uint64_t triangles = 0;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m)
+      if (scene->mMeshes[m]->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) triangles += scene->mMeshes[m]->mNumFaces;
+    if (triangles > limits.max_triangles) {
+      *error = "the file has " + std::to_string(triangles) + " triangles, more than the limit of " +
+               std::to_string(limits.max_triangles);
+      return false;
+    }
+    TriangleMesh raw;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const aiMesh* in = scene->mMeshes[m];
+      if (!(in->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || !in->mVertices) continue;
+      const std::uint64_t base = raw.vertex_count();
+      if (base + in->mNumVertices > UINT32_MAX) {
+        *error = "the file has too many vertices";
+        return false;
+      }
+      for (unsigned v = 0; v < in->mNumVertices; ++v) {
+        raw.positions.push_back(in->mVertices[v].x);
+        raw.positions.push_back(in->mVertices[v].y);
+        raw.positions.push_back(in->mVertices[v].z);
+      }
+      for (unsigned f = 0; f < in->mNumFaces; ++f) {
+        const aiFace& face = in->mFaces[f];
+        if (face.mNumIndices != 3) continue;
+        for (int k = 0; k < 3; ++k) {
+          if (face.mIndices[k] >= in->mNumVertices) {
+            *error = "a face refers to a vertex that does not exist";
+            return false;
+          }
+          raw.indices.push_back(static_cast<std::uint32_t>(base + face.mIndices[k]));
+        }
+      }
+    }
+    for (double p : raw.positions)
+      if (!std::isfinite(p) || std::abs(p) > kMaxCoordinate) {
+        *error = "a vertex position is not finite or farther than 1e7 m from the origin";
+        return false;
+      }
+    TriangleMesh canonical = canonicalize_mesh(raw);
+    if (canonical.triangle_count() == 0) {
+      *error = "the file has no triangles of non-zero area";
+      return false;
+    }
+    if (canonical.vertex_count() > limits.max_vertices) {
+      *error = "the mesh has " + std::to_string(canonical.vertex_count()) + " vertices, more than the limit of " +
+               std::to_string(limits.max_vertices);
+      return false;
+    }
+    *mesh = std::move(canonical);
+    return true;
+  } catch (const std::exception& e) {
+    *error = std::string("the ") + extension + " file could not be read: " + e.what();
+    return false;
+  }
+}
+
+}  // namespace skyfarm::assets
