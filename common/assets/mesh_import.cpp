@@ -10,6 +10,7 @@
 
 #include <assimp/BaseImporter.h>
 #include <assimp/Importer.hpp>
+#include <assimp/importerdesc.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -41,13 +42,54 @@ const char* extension_of(std::string_view format) {
   return nullptr;
 }
 
-// Keeps only the loader of `extension` (the glTF 2.0 one for gltf/glb).
+// Keeps only the loaders that claim `extension` (glTF has two: 1.0 and 2.0;
+// the 2.0 one reads only version 2 files).
 void keep_one_loader(Assimp::Importer& importer, const char* extension) {
-  Assimp::BaseImporter* keep = importer.GetImporter(extension);
   std::vector<Assimp::BaseImporter*> others;
-  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i)
-    if (Assimp::BaseImporter* loader = importer.GetImporter(i); loader != keep) others.push_back(loader);
+  for (std::size_t i = 0; i < importer.GetImporterCount(); ++i) {
+    Assimp::BaseImporter* loader = importer.GetImporter(i);
+    const aiImporterDesc* info = importer.GetImporterInfo(i);
+    bool claims = false;
+    if (info && info->mFileExtensions) {
+      std::string_view list = info->mFileExtensions;
+      while (!list.empty()) {
+        const std::size_t space = list.find(' ');
+        if (list.substr(0, space) == extension) claims = true;
+        list = space == std::string_view::npos ? std::string_view() : list.substr(space + 1);
+      }
+    }
+    if (!claims) others.push_back(loader);
+  }
   for (Assimp::BaseImporter* loader : others) importer.UnregisterLoader(loader);
+}
+
+// assimp walks every element a PLY header declares, present or not (a
+// 10-byte header saying 1e9 vertices costs a minute of CPU): each element
+// takes at least one byte in a binary file and two ("0\n") in an ASCII one.
+bool ply_counts_fit(std::string_view bytes, std::string* error) {
+  const std::size_t end = bytes.find("end_header");
+  if (end == std::string_view::npos) return true;  // assimp refuses it itself
+  const bool ascii = bytes.substr(0, end).find("format ascii") != std::string_view::npos;
+  const std::uint64_t body = bytes.size() - end;
+  std::uint64_t elements = 0;
+  for (std::size_t at = bytes.find("element"); at != std::string_view::npos && at < end;
+       at = bytes.find("element", at + 7)) {
+    const std::size_t eol = bytes.find('\n', at);
+    const std::string_view line = bytes.substr(at, eol == std::string_view::npos ? std::string_view::npos : eol - at);
+    const std::size_t last = line.find_last_of(' ');
+    if (last == std::string_view::npos) continue;
+    std::uint64_t count = 0;
+    for (char c : line.substr(last + 1)) {
+      if (c < '0' || c > '9') break;
+      count = std::min<std::uint64_t>(count * 10 + static_cast<std::uint64_t>(c - '0'), std::uint64_t{1} << 40);
+    }
+    elements += count;
+  }
+  if (elements * (ascii ? 2 : 1) > body) {
+    *error = "the PLY header declares " + std::to_string(elements) + " elements, more than the file holds";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -82,6 +124,7 @@ bool import_mesh(std::string_view bytes, std::string_view format, const MeshLimi
     *error = "the mesh file is empty";
     return false;
   }
+  if (format == "ply" && !ply_counts_fit(bytes, error)) return false;
   try {
     Assimp::Importer importer;
     keep_one_loader(importer, extension);

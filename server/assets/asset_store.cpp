@@ -3,6 +3,7 @@
 #include <sodium.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -60,12 +61,27 @@ AssetStore::AssetStore(const std::string& data_dir, AssetStoreOptions options)
     : dir_((fs::path(data_dir) / "assets").string()), options_(std::move(options)) {
   fs::create_directories(dir_);
   options_.import.work_dir = (fs::path(dir_) / "tmp").string();
+  fs::remove_all(options_.import.work_dir);
   fs::create_directories(options_.import.work_dir);
 }
 
 AssetPut AssetStore::put(std::string_view bytes, std::string_view format) {
   AssetPut put;
-  MeshImportResult imported = run_mesh_import(bytes, format, options_.import);
+  MeshImportResult imported;
+  {
+    std::unique_lock lock(mutex_);
+    turn_.wait(lock, [&] { return importing_ < std::max(1, options_.max_concurrent_imports); });
+    ++importing_;
+  }
+  struct Release {
+    AssetStore* store;
+    ~Release() {
+      std::lock_guard lock(store->mutex_);
+      --store->importing_;
+      store->turn_.notify_one();
+    }
+  } release{this};
+  imported = run_mesh_import(bytes, format, options_.import);
   if (!imported.ok) {
     put.error = std::move(imported.error);
     return put;

@@ -11,10 +11,15 @@
 // against its id.  Files are written to a temporary name and renamed, so a
 // reader never sees half a file and concurrent uploads of one mesh agree.
 //
-// Options: `max_upload_bytes` (the HTTP body limit of an upload) and
-// `import` (the child process, its limits; work_dir is set here).
+// Options: `max_upload_bytes` (the HTTP body limit of an upload),
+// `max_concurrent_imports` (children at once; more uploads wait their turn,
+// so that N uploads cannot ask for N x memory_bytes) and `import` (the child
+// process, its limits; work_dir is set here, and emptied at start: what is
+// there is left from a server that stopped mid-import).
 #pragma once
+#include <condition_variable>
 #include <cstddef>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -27,6 +32,7 @@ namespace skyfarm::server {
 
 struct AssetStoreOptions {
   std::size_t max_upload_bytes = 64u << 20;
+  int max_concurrent_imports = 2;
   MeshImportOptions import;
 };
 
@@ -55,6 +61,9 @@ class AssetStore {
  private:
   std::string dir_;
   AssetStoreOptions options_;
+  std::mutex mutex_;
+  std::condition_variable turn_;
+  int importing_ = 0;
 };
 
 // "sha256:" and 64 lowercase hex digits.
