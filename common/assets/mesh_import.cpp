@@ -125,6 +125,15 @@ bool import_mesh(std::string_view bytes, std::string_view format, const MeshLimi
     return false;
   }
   if (format == "ply" && !ply_counts_fit(bytes, error)) return false;
+  if (format == "glb" && bytes.size() >= 12) {
+    std::uint32_t length;
+    std::memcpy(&length, bytes.data() + 8, 4);
+    if (length != bytes.size()) {
+      *error = "the GLB header's length (" + std::to_string(length) + ") is not the file's (" +
+               std::to_string(bytes.size()) + ")";
+      return false;
+    }
+  }
   try {
     Assimp::Importer importer;
     keep_one_loader(importer, extension);
