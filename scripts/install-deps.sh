@@ -11,6 +11,7 @@ packages=(
   libcpp-httplib-dev libzmq3-dev cppzmq-dev libsodium-dev libsqlite3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev               # the BVH over the scene's triangles (common/accel)
+  libassimp-dev               # mesh assets' import (common/assets/mesh_import.h)
   ffmpeg
   file                        # cpack -G DEB finds the programs' libraries with it
   yamllint python3-yaml       # the deployment files' tests (tests/deploy)

@@ -21,6 +21,8 @@
 #include "server/probes/probe_service.h"
 #include "server/server_options.h"
 #include "server/timelapse/timelapse_service.h"
+#include "server/assets/asset_store.h"
+#include "server/assets/mesh_import_process.h"
 
 namespace {
 
@@ -97,6 +99,8 @@ int main(int argc, char** argv) {
   using namespace skyfarm::server;
   if (argc >= 2 && std::string(argv[1]) == "keygen")
     return skyfarm::api::run_keygen_command("skyfarm-server", {argv + 2, argv + argc});
+  // The mesh import's child process (server/assets/mesh_import_process.h), run by this server.
+  if (argc >= 2 && std::string(argv[1]) == "import-mesh") return run_import_mesh_command({argv + 2, argv + argc});
   ServerOptions options;
   if (const std::string err = parse_server_options({argv + 1, argv + argc}, &options); !err.empty()) {
     std::cerr << "skyfarm-server: " << err << "\n" << kServerUsage;
@@ -171,6 +175,10 @@ int main(int argc, char** argv) {
     sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
     http_options.sky = std::make_shared<SkyService>(sky);
     http_options.timelapses = &timelapses;
+    AssetStoreOptions asset_options;
+    asset_options.import.command = {"/proc/self/exe", "import-mesh"};
+    AssetStore assets(options.data_dir, asset_options);
+    http_options.assets = &assets;
     http_options.extra_metrics = [&broker] {
       const BrokerStats s = broker.stats();
       return nlohmann::json{{"auth_failures", s.auth_failures}, {"results_refused", s.results_refused}};

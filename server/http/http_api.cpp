@@ -20,6 +20,7 @@
 #include "server/sky/http_sky.h"
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
+#include "server/assets/asset_http.h"
 #include "api/probe_answer.h"
 #include "api/probe_spec.h"
 
@@ -74,6 +75,7 @@ nlohmann::json render_links(const std::string& id) {
 // "GET, HEAD, POST" for a path the API serves with other methods, else nullopt.
 std::optional<std::string_view> allowed_methods(std::string_view path) {
   if (auto timelapse = timelapse_allowed_methods(path)) return timelapse;
+  if (auto asset = asset_allowed_methods(path)) return asset;
   if (path == "/v1/renders") return "GET, HEAD, POST";
   if (path == "/v1/sky/radiance") return "POST";
   if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
@@ -201,6 +203,7 @@ HttpApi::HttpApi(HttpBackend& backend, HttpOptions options)
                                      options_.token.has_value())) {
   if (options_.timelapses)
     timelapses_ = std::make_unique<TimelapseHttp>(*options_.timelapses, options_.token.has_value());
+  if (options_.assets) assets_ = std::make_unique<AssetHttp>(*options_.assets);
 }
 
 HttpApi::~HttpApi() = default;
@@ -213,7 +216,8 @@ void HttpApi::register_routes(httplib::Server& server) {
 }
 
 void HttpApi::configure_server(httplib::Server& server) {
-  server.set_payload_max_length(options_.max_body_bytes);
+  // The largest body any route takes; each route reads its own limit.
+  server.set_payload_max_length(std::max(options_.max_body_bytes, body_limit("/v1/assets")));
   server.set_read_timeout(kReadTimeoutS, 0);
   server.set_write_timeout(kWriteTimeoutS, 0);
   server.set_keep_alive_max_count(kKeepAliveMaxCount);
@@ -252,11 +256,11 @@ int HttpApi::expect_continue(const Request& req, Response& res) const {
   run_guarded(req, res, [&] {
     if (!admitted(req, res)) {
       status = 401;
-    } else if (declared_length(req) > options_.max_body_bytes) {
+    } else if (declared_length(req) > body_limit(req.path)) {
       res.set_header("Connection", "close");
       Problem p;
       p.status = 413;
-      p.detail = generic_detail(413, options_.max_body_bytes);
+      p.detail = generic_detail(413, body_limit(req.path));
       send_problem(res, p, req.path);
       status = 413;
     }
@@ -275,7 +279,7 @@ bool HttpApi::answer_library_error(const Request& req, Response& res) {
     }
     Problem p;
     p.status = res.status;
-    p.detail = generic_detail(res.status, options_.max_body_bytes);
+    p.detail = generic_detail(res.status, body_limit(req.path));
     send_problem(res, p, req.path);
   });
   return true;
@@ -335,6 +339,12 @@ void HttpApi::add_routes(httplib::Server& server) {
                    return body;
                  },
                  [](const Request& req) { return idempotency_key_of(req); }});
+  if (assets_)
+    assets_->add_routes(routes, {[](const Request& req, Response& res, const std::function<void()>& handler) {
+                                   run_guarded(req, res, handler);
+                                 },
+                                 [this](const Request& req, Response& res, const ContentReader& reader,
+                                        std::size_t limit) { return read_body(req, res, reader, limit); }});
   routes_ = routes.added();
 }
 
@@ -533,12 +543,22 @@ void HttpApi::fallback(const Request& req, Response& res) {
 
 // --- Helpers -----------------------------------------------------------------
 
+std::size_t HttpApi::body_limit(std::string_view path) const {
+  if (options_.assets && path == "/v1/assets") return options_.assets->options().max_upload_bytes;
+  return options_.max_body_bytes;
+}
+
 std::string HttpApi::read_body(const Request& req, Response& res, const ContentReader& reader) const {
+  return read_body(req, res, reader, options_.max_body_bytes);
+}
+
+std::string HttpApi::read_body(const Request& req, Response& res, const ContentReader& reader,
+                               std::size_t limit) const {
   if (!has_body(req)) return {};  // no Content-Length nor Transfer-Encoding: an empty body (RFC 9112 §6.3)
   std::string body;
   bool too_large = false;
   const bool complete = reader([&](const char* data, std::size_t n) {
-    if (n > options_.max_body_bytes - body.size()) {
+    if (n > limit - body.size()) {
       too_large = true;  // chunked bodies: httplib 0.11 does not bound them itself
       return false;
     }
@@ -547,7 +567,7 @@ std::string HttpApi::read_body(const Request& req, Response& res, const ContentR
   });
   if (too_large || res.status == 413) {
     if (too_large) res.set_header("Connection", "close");  // the rest of the body is still on the wire
-    throw http_error(413, generic_detail(413, options_.max_body_bytes));
+    throw http_error(413, generic_detail(413, limit));
   }
   if (!complete) {
     res.set_header("Connection", "close");

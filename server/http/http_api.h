@@ -24,6 +24,8 @@
 //   GET    /healthz                     {"status": "ok"}; never needs the token
 //   /v1/timelapses...                   timelapses, when HttpOptions::timelapses is set
 //                                       (server/timelapse/timelapse_http.h)
+//   /v1/assets...                       mesh assets, when HttpOptions::assets is set
+//                                       (server/assets/asset_http.h)
 //   GET    /metrics                     Prometheus text (text/plain; version=0.0.4)
 // Job ids are 1-64 of [A-Za-z0-9_-] (else 400, before the backend sees them).
 //
@@ -68,6 +70,8 @@
 
 namespace skyfarm::server {
 
+class AssetHttp;
+class AssetStore;
 class GatedHttpServer;
 struct Route;
 class SkyHttp;
@@ -93,6 +97,9 @@ struct HttpOptions {
   std::chrono::milliseconds probe_timeout = std::chrono::seconds(120);  // 504 beyond (server/probes/http_probe.h)
   // The timelapses (not owned; must outlive the HttpApi); null: no /v1/timelapses routes.
   TimelapseService* timelapses = nullptr;
+  // The mesh assets (not owned; must outlive the HttpApi); null: no /v1/assets routes.
+  // Their uploads have their own body limit (AssetStoreOptions::max_upload_bytes).
+  AssetStore* assets = nullptr;
   // More figures for /metrics (e.g. the broker's auth_failures, results_refused),
   // added to the backend's (summed where both have one); may be empty.
   std::function<nlohmann::json()> extra_metrics;
@@ -153,6 +160,10 @@ class HttpApi {
   // Helpers.
   std::string read_body(const httplib::Request& req, httplib::Response& res,
                         const httplib::ContentReader& reader) const;
+  std::string read_body(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader,
+                        std::size_t limit) const;
+  // The body limit of a path: max_body_bytes, or the asset uploads' own.
+  std::size_t body_limit(std::string_view path) const;
   void image(const httplib::Request& req, httplib::Response& res, ImageFormat format);
   bool authorized(const httplib::Request& req) const;
   void answer_unauthorized(const httplib::Request& req, httplib::Response& res) const;
@@ -163,6 +174,7 @@ class HttpApi {
   ResponseCounter responses_;
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
+  std::unique_ptr<AssetHttp> assets_;
   const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
   std::vector<Route> routes_;
 };

@@ -22,6 +22,7 @@
 #include "server/http/http_openapi.h"
 #include "server/jobs/job_service.h"
 #include "server/timelapse/timelapse_service.h"
+#include "server/assets/asset_store.h"
 #include "tests/support/http_fixture.h"
 
 namespace skyfarm::server {
@@ -103,14 +104,18 @@ TEST(HttpRoutes, TheDocumentIsReadWhole) {
             (std::set<Route>{{"GET", "/a"}, {"DELETE", "/b/{id}"}}));
 }
 
-// The server's routes, timelapses included, and the document's operations.
+// The server's routes, timelapses and assets included, and the document's operations.
 class HttpRoutesServed : public testing::HttpFixture {
  protected:
   void SetUp() override {
     jobs_ = std::make_unique<JobService>(dir_);
     timelapses_ = std::make_unique<TimelapseService>(*jobs_, dir_);
+    AssetStoreOptions asset_options;
+    asset_options.import.command = {SKYFARM_SERVER_BINARY, "import-mesh"};
+    assets_ = std::make_unique<AssetStore>(dir_.string(), asset_options);
     HttpOptions options;
     options.timelapses = timelapses_.get();
+    options.assets = assets_.get();
     serve(std::move(options));
   }
   void TearDown() override {
@@ -122,6 +127,7 @@ class HttpRoutesServed : public testing::HttpFixture {
   const fs::path dir_ = fresh_dir("served");
   std::unique_ptr<JobService> jobs_;
   std::unique_ptr<TimelapseService> timelapses_;
+  std::unique_ptr<AssetStore> assets_;
 };
 
 TEST_F(HttpRoutesServed, TheServerAnswersExactlyTheDocumentsOperations) {
