@@ -153,7 +153,9 @@ TEST_F(HttpRoutesServed, OptionsNamesTheMethodOfEveryRoute) {
     EXPECT_EQ(res->status, 204) << r.method << " " << r.path << ": " << res->body;
     const std::string allow = res->get_header_value("Allow");
     EXPECT_NE(allow.find(r.method), std::string::npos) << r.method << " " << r.path << ": Allow " << allow;
-    if (r.method == "GET") EXPECT_NE(allow.find("HEAD"), std::string::npos) << r.path << ": Allow " << allow;
+    if (r.method == "GET") {
+      EXPECT_NE(allow.find("HEAD"), std::string::npos) << r.path << ": Allow " << allow;
+    }
   }
 }
 
