@@ -70,21 +70,6 @@ SampledSpectrum mixture_phase(const MediumPoint& mp, const PathPhases& phases, d
   return safe_div(p, mp.sigma_s);
 }
 
-// The ground's local frame at the unit normal n: s towards the east (the
-// anisotropic roughness_x axis), t towards the north, as at the observer
-// (x east, y north, z up).  At the two points where east is undefined any
-// frame will do: no camera looks there.
-Frame ground_frame(const glm::dvec3& n) {
-  const glm::dvec3 east = glm::cross(glm::dvec3(0.0, 1.0, 0.0), n);
-  const double length = glm::length(east);
-  if (!(length > 1e-12)) return Frame(n);
-  Frame f;
-  f.n = n;
-  f.s = east / length;
-  f.t = glm::cross(n, f.s);
-  return f;
-}
-
 // An object's frame at the unit normal n (the side the ray came from): s
 // along its tangent made perpendicular to n.
 Frame surface_frame(const glm::dvec3& n, const glm::dvec3& tangent) {
@@ -97,6 +82,12 @@ Frame surface_frame(const glm::dvec3& n, const glm::dvec3& tangent) {
   f.t = glm::cross(n, f.s);
   return f;
 }
+
+// The ground's local frame at the unit normal n: s towards the east (the
+// anisotropic roughness_x axis), t towards the north, as at the observer
+// (x east, y north, z up).  At the two points where east is undefined any
+// frame will do: no camera looks there.
+Frame ground_frame(const glm::dvec3& n) { return surface_frame(n, glm::cross(glm::dvec3(0.0, 1.0, 0.0), n)); }
 
 // The seed of a BSDF's own random sequence for one stochastic evaluation:
 // one of the path's numbers, so still a pure function of (job seed, pixel,
