@@ -32,24 +32,19 @@
 namespace skyfarm::material {
 namespace {
 
+using testing::bin_of;
+using testing::kBins;
+using testing::kPhiBins;
+using testing::kThetaBins;
+using testing::l1_distance;
+
 constexpr double kPi = 3.14159265358979323846;
-constexpr int kThetaBins = 6;  // uniform in cos(theta)
-constexpr int kPhiBins = 8;
-constexpr int kBins = kThetaBins * kPhiBins;
 constexpr int kOrders = 4;  // E_r of orders 1, 2, 3 and >= 4
 
 // The surface every comparison runs on: 512^2 samples, correlation length 8
 // cells, so one period holds (512 / 8)^2 = 4096 independent patches.
 constexpr int kSize = 512;
 constexpr double kCorrelation = 8.0;
-
-int bin_of(const glm::dvec3& w) {
-  if (w.z <= 0.0) return -1;
-  const int t = std::min(kThetaBins - 1, static_cast<int>(w.z * kThetaBins));
-  const double phi = std::atan2(w.y, w.x) + kPi;
-  const int p = std::min(kPhiBins - 1, static_cast<int>(phi / (2.0 * kPi) * kPhiBins));
-  return t * kPhiBins + p;
-}
 
 struct Lobe {
   std::array<double, kOrders> energy{};                            // E_r per order, fraction of the walks
@@ -88,7 +83,6 @@ Lobe tally(Trace trace, int walks) {
   return lobe;
 }
 
-using testing::l1_distance;
 
 // What two lobes drawn from the SAME distribution would show as L1 distance,
 // from the counts alone: each normalised bin is off by a normal error of

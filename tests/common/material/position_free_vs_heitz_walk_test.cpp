@@ -21,18 +21,13 @@
 namespace skyfarm::material {
 namespace {
 
-constexpr int kThetaBins = 6;  // uniform in cos(theta)
-constexpr int kPhiBins = 8;
-constexpr int kBins = kThetaBins * kPhiBins;
-constexpr double kPi = 3.14159265358979323846;
+using testing::bin_of;
+using testing::kBins;
+using testing::kPhiBins;
+using testing::kThetaBins;
+using testing::l1_distance;
 
-int bin_of(const glm::dvec3& w) {
-  if (w.z <= 0.0) return -1;
-  const int t = std::min(kThetaBins - 1, static_cast<int>(w.z * kThetaBins));
-  const double phi = std::atan2(w.y, w.x) + kPi;
-  const int p = std::min(kPhiBins - 1, static_cast<int>(phi / (2.0 * kPi) * kPhiBins));
-  return t * kPhiBins + p;
-}
+constexpr double kPi = 3.14159265358979323846;
 
 struct Lobes {
   std::vector<double> single = std::vector<double>(kBins, 0.0);
@@ -54,7 +49,6 @@ double chi_square(const std::vector<double>& a, const std::vector<double>& b, in
   return chi;
 }
 
-using testing::l1_distance;
 
 struct Case {
   std::string name;
