@@ -4,7 +4,7 @@
 
 namespace skyfarm {
 
-RenderSetup make_render_setup(const RenderSpec& spec) {
+RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* /*meshes*/) {
   RenderSetup s;
   s.scene = std::make_unique<Scene>(Scene::from_specs(spec.atmosphere, spec.sun, spec.location, spec.time,
                                                       spec.lambda_min_nm, spec.lambda_max_nm));

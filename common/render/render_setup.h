@@ -18,10 +18,12 @@
 #include <memory>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera.h"
 #include "common/camera/camera_spec.h"
+#include "common/objects/object_spec.h"
 #include "common/film/error_estimate.h"
 #include "common/film/image.h"
 #include "common/render/render_plan.h"
@@ -37,6 +39,7 @@ struct RenderSpec {
   std::optional<UtcInstant> time;
   SunSpec sun;
   AtmosphereSpec atmosphere;
+  std::vector<ObjectSpec> objects;  // none: the plain sky, no BVH built
   // The view, the wavelengths and the samples.
   CameraSpec camera;
   double lambda_min_nm = 360.0, lambda_max_nm = 830.0;
@@ -53,7 +56,12 @@ struct RenderSetup {
   RenderPlan plan;
 };
 
-RenderSetup make_render_setup(const RenderSpec& spec);
+namespace assets {
+class MeshSource;
+}
+// `meshes` resolves the mesh objects' asset ids; it may be null for a spec
+// without mesh objects (one with them then throws std::runtime_error).
+RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes = nullptr);
 
 // The plan of a render (tiles, batches, passes, mirror symmetry), given its sun.
 RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun);
