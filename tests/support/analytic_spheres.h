@@ -43,6 +43,7 @@ class AnalyticSpheres final : public SceneObjects {
         h.tangent = std::abs(h.n.z) < 0.999 ? glm::normalize(glm::cross(glm::dvec3(0, 0, 1), h.n)) : glm::dvec3(1, 0, 0);
         h.surface = s.surface;
         h.offset_m = 1e-7 * std::max(1.0, s.radius_m);
+        h.solid = true;
         best = h;
         break;
       }
