@@ -88,6 +88,30 @@ TEST(GlassObjects, GlassSphereInTheFurnaceHasTheEnvironmentsRadiance) {
   }
 }
 
+// A glass surface that does not bound a body (SurfaceHit::solid false: a
+// sheet) stays opaque, as the ground: what it transmits is absorbed, so in
+// the furnace a smooth one shows the environment times its Fresnel
+// reflectance at the angle it is seen at, and nothing of the inside (the
+// noise is the roulette of the reflected paths, which are down to F).
+TEST(GlassObjects, GlassSheetIsOpaqueAndReflectsFresnel) {
+  Scene scene = furnace();
+  const material::Surface sheet(glass(1.5));
+  testing::AnalyticSpheres::Sphere s{kFurnaceCentre, 1.0, &sheet};
+  s.solid = false;
+  scene.set_objects(std::make_shared<testing::AnalyticSpheres>(scene.observer(),
+                                                               std::vector<testing::AnalyticSpheres::Sphere>{s}));
+  const std::vector<glm::dvec3> dirs = {glm::normalize(kFurnaceCentre),
+                                        glm::normalize(kFurnaceCentre + glm::dvec3(0.5, 0, 0.3))};
+  const ProbeResult r = probe_radiance(scene, dirs, {450.0}, 4096, 5, 2);
+  for (std::size_t d = 0; d < dirs.size(); ++d) {
+    const glm::dvec3 o = -kFurnaceCentre;  // the observer from the centre
+    const double b = glm::dot(o, dirs[d]), t = -b - std::sqrt(b * b - (glm::dot(o, o) - 1.0));
+    const double cos_theta = -glm::dot(dirs[d], glm::normalize(o + t * dirs[d]));
+    EXPECT_NEAR(r.radiance[d][0], material::fresnel_dielectric(cos_theta, 1.5), 4.0 * r.standard_error[d][0] + 1e-9)
+        << "direction " << d;
+  }
+}
+
 // A dispersive glass (BK7, n from 1.53 at 400 nm to 1.51 at 700 nm) seen
 // with four different wavelengths per path: a refraction sends them apart,
 // so the path keeps only its hero, whose light counts for all four (the
