@@ -57,7 +57,9 @@ SurfaceBsdf Surface::bsdf(double lambda_nm, Body body) const {
     case MaterialKind::kDielectric: {
       const double eta = material_->ior().n(lambda_nm);
       if (transmits(body)) {
-        if (spec_.smooth()) return SurfaceBsdf(SmoothDielectric(eta));
+        // Without the (n_wo / n_wi)^2 radiance factor, as the rough forms
+        // evaluated the way the path tracer does (surface.h).
+        if (spec_.smooth()) return SurfaceBsdf(SmoothDielectric(eta, TransportMode::importance));
         if (spec_.multiple_bounce) return SurfaceBsdf(MultipleBounceBsdf(d, Facet::dielectric(eta)));
         return SurfaceBsdf(RoughDielectric(d, eta));
       }

@@ -17,7 +17,13 @@
 //   kSolid   the surface bounds a closed, non-absorbing body of the material
 //            (a glass object): light crosses it, the BSDF is the full one,
 //            its macro normal the OUTWARD one (+z outside, the inside below),
-//            and wo may be on either side.
+//            and wo may be on either side.  A crossing carries no
+//            (n_wo / n_wi)^2 radiance factor: a path enters and leaves a
+//            body through its surface, so the factors cancel, and a
+//            throughput that dipped by n^2 inside would make the path
+//            tracer's roulette kill paths there for nothing.  (The rough
+//            forms, evaluated f(wi, wo) as the path tracer does, have none
+//            either: their transposed radiance form is the flux form.)
 // Conductors and diffuse materials are the same for both bodies.
 //
 // white_sky_albedo(lambda) is the surface's bihemispherical reflectance: the

@@ -536,10 +536,10 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // direction below leaves from p_below into the body, where the path meets
 // nothing but the body's surface again (PathState::in_solid).  The sun's
 // NEE is made towards directions above only (from p_above): one below
-// would cross the body, which blocks it.  The radiance factor (n_wo/n_wi)^2
-// of each crossing cancels with that of the crossing back out, and every
-// path starts (the camera) and ends (the sun, the sky) outside the bodies,
-// so any one convention, held to at every crossing, is exact.
+// would cross the body, which blocks it.  The crossings carry no radiance
+// factor (n_wo/n_wi)^2 (material/surface.h): every path starts (the
+// camera) and ends (the sun, the sky) outside the bodies, entering and
+// leaving each through its surface, so the factors would cancel anyway.
 //
 // A smooth dielectric picks its lobe (reflect, refract) with the hero's
 // Fresnel probability; each wavelength's weight and r_u take its own F
@@ -566,8 +566,9 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // Swapped, a non-absorbing ground under a uniform sky returns all its light
 // to the camera, as any closed isothermal scene must.  The reciprocal forms
 // (Lambertian, single-bounce conductor, the smooth reflector, dielectric
-// reflection) are unchanged by the swap; a dielectric's transmission takes
-// the transposed radiance factor, which cancels along a path as above.
+// reflection) are unchanged by the swap; a dielectric's transmission loses
+// its radiance factor by it (the transposed radiance form is the flux
+// form), as the smooth dielectric of a solid has none.
 bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, material::Body body,
                                              const glm::dvec3& p_above, const glm::dvec3& p_below,
                                              const Frame& frame, const PathContext& c, int depth, Ray* ray,

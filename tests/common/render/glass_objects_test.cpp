@@ -49,8 +49,9 @@ Scene vacuum(double sun_zenith, double observer_height) {
 
 // The white furnace: vacuum, a white ground, a uniform sky of radiance 1
 // and no sun.  Nothing absorbs, so every direction sees radiance 1 (the
-// glass's included: what enters a non-absorbing body leaves it, and the
-// (n_wo / n_wi)^2 of each crossing cancels with the one back out).
+// glass's included: what enters a non-absorbing body leaves it).  The
+// smooth glass is exact: its crossings carry no radiance factor, so no
+// path is rouletted.
 Scene furnace() {
   AtmosphereSpec spec = testing::thin_hg_layer(1e-12, 1000.0, 0.0);
   spec.ground_albedo = 1.0;
@@ -80,7 +81,7 @@ TEST(GlassObjects, GlassSphereInTheFurnaceHasTheEnvironmentsRadiance) {
     const ProbeResult r = probe_radiance(scene, dirs, {450.0}, 4096, 5, 2);
     EXPECT_EQ(r.counters.nonfinite, 0u);
     for (std::size_t d = 0; d < dirs.size(); ++d) {
-      EXPECT_NEAR(r.radiance[d][0], 1.0, 4.0 * r.standard_error[d][0] + 1e-9)
+      EXPECT_NEAR(r.radiance[d][0], 1.0, 4.0 * r.standard_error[d][0] + 1e-6)
           << "roughness " << roughness << ", direction " << d;
       std::printf("roughness %.1f direction %zu: L %.4f +- %.4f\n", roughness, d, r.radiance[d][0],
                   r.standard_error[d][0]);
@@ -234,8 +235,8 @@ double ball_lens_ratio(double h, double R, double n, double alpha, int n_dirs) {
 // at most 10 % of f short of f, thousands of times brighter than the open
 // ground (rho L_sun sin^2 alpha; the sun's image is blurred only by the
 // disk, f alpha = 3.5 mm), and past f the light falls: at 1.05 f less than
-// half of what it is at f.  (Measured: the peak at 0.95 f, 2600 times the
-// open ground, 1600 at f, 330 at 1.05 f.)  Each spot also agrees with the
+// half of what it is at f.  (Measured: the peak at 0.95 f, 2700 times the
+// open ground, 1600 at f, 320 at 1.05 f.)  Each spot also agrees with the
 // independent trace above (ball_lens_ratio: one refraction in and one out)
 // within 4 standard errors plus 3 % of the brightest spot, the light the
 // trace leaves out (internal reflections) being a few % of a spot at most.
