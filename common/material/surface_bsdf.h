@@ -55,9 +55,6 @@ class SurfaceBsdf {
   }
   // The smooth interface light crosses, or null.
   const SmoothDielectric* smooth_dielectric() const { return std::get_if<SmoothDielectric>(&bsdf_); }
-  // Whether light crosses the surface (a dielectric of a solid body): the
-  // BSDF's own proposal, directions on both sides.
-  bool transmits() const { return !reflection_ && !empty() && (get().flags() & kBsdfTransmission) != 0; }
 
   // A direction drawn from the proposal (density pdf(wo, .)) without
   // evaluating f: the path tracer proposes with the hero wavelength's BSDF
