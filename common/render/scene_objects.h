@@ -24,11 +24,7 @@ struct SurfaceHit {
   glm::dvec3 tangent{1.0, 0.0, 0.0};  // a unit tangent: the anisotropic roughness_x axis
   const material::Surface* surface = nullptr;  // the object's material (never null)
   double offset_m = 1e-6;     // how far rays leaving the hit start off the surface
-  // The surface bounds a closed body (sphere, box, closed mesh; n outward),
-  // not a two-sided sheet (disc, rectangle, open mesh): light may cross it
-  // into the body (a dielectric: material::Body::kSolid) and the path
-  // tracer keeps n outward there.  A sheet is opaque whatever its material.
-  bool solid = false;
+  bool solid = false;         // the object encloses a volume (n points out of it); else a two-sided sheet
 };
 
 class SceneObjects {
