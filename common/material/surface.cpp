@@ -43,7 +43,7 @@ Surface::Surface(SurfaceSpec spec) : spec_(std::move(spec)), material_(resolve(s
                                 std::to_string(kMaxRoughness) + "] along both axes");
 }
 
-SurfaceBsdf Surface::bsdf(double lambda_nm) const {
+SurfaceBsdf Surface::bsdf(double lambda_nm, Body body) const {
   // A smooth surface has no distribution (alpha 0 is its delta limit).
   const MicrofacetDistribution d(spec_.distribution, spec_.smooth() ? 1.0 : spec_.roughness_x,
                                  spec_.smooth() ? 1.0 : spec_.roughness_y);
@@ -56,6 +56,13 @@ SurfaceBsdf Surface::bsdf(double lambda_nm) const {
     }
     case MaterialKind::kDielectric: {
       const double eta = material_->ior().n(lambda_nm);
+      if (transmits(body)) {
+        // Without the (n_wo / n_wi)^2 radiance factor, as the rough forms
+        // evaluated the way the path tracer does (surface.h).
+        if (spec_.smooth()) return SurfaceBsdf(SmoothDielectric(eta, TransportMode::importance));
+        if (spec_.multiple_bounce) return SurfaceBsdf(MultipleBounceBsdf(d, Facet::dielectric(eta)));
+        return SurfaceBsdf(RoughDielectric(d, eta));
+      }
       // Over an opaque body: only the reflected directions are proposed.
       if (spec_.smooth()) return SurfaceBsdf(SmoothReflector::dielectric(eta));
       if (spec_.multiple_bounce)

@@ -4,13 +4,27 @@
 //   kind        roughness 0                    roughness > 0
 //   conductor   SmoothReflector (complex n)    RoughConductor / MultipleBounceBsdf(conductor facets)
 //   dielectric  SmoothReflector (Fresnel)      RoughDielectric / MultipleBounceBsdf(dielectric facets)
+//     in a solid SmoothDielectric               the same, with their own proposal (both sides)
 //   diffuse     Lambertian (albedo)            RoughDiffuse / MultipleBounceBsdf(diffuse facets)
 //
 // The single-bounce form is used when spec.multiple_bounce is false.  A
 // dielectric's relative index is its n at the wavelength (the air above
 // counts as 1, its 3e-4 excess is far below the tables' accuracy); its k is
-// not used at the interface (water's k < 1e-8 in the visible) and what is
-// transmitted into it is absorbed (deep water, an opaque body).
+// not used at the interface (water's k < 1e-8 in the visible).  What a
+// dielectric transmits depends on the body behind the surface (Body):
+//   kOpaque  absorbed (the ground: deep water); only reflected directions
+//            are proposed (SurfaceBsdf::reflection_only).
+//   kSolid   the surface bounds a closed, non-absorbing body of the material
+//            (a glass object): light crosses it, the BSDF is the full one,
+//            its macro normal the OUTWARD one (+z outside, the inside below),
+//            and wo may be on either side.  A crossing carries no
+//            (n_wo / n_wi)^2 radiance factor: a path enters and leaves a
+//            body through its surface, so the factors cancel, and a
+//            throughput that dipped by n^2 inside would make the path
+//            tracer's roulette kill paths there for nothing.  (The rough
+//            forms, evaluated f(wi, wo) as the path tracer does, have none
+//            either: their transposed radiance form is the flux form.)
+// Conductors and diffuse materials are the same for both bodies.
 //
 // white_sky_albedo(lambda) is the surface's bihemispherical reflectance: the
 // directional albedo A(mu) = integral f cos dwi averaged over incident
@@ -31,6 +45,8 @@
 
 namespace skyfarm::material {
 
+enum class Body { kOpaque, kSolid };
+
 class Surface {
  public:
   // Throws std::invalid_argument naming what is wrong (an unknown name, a
@@ -45,7 +61,9 @@ class Surface {
   // A smooth conductor or dielectric: a delta lobe.
   bool specular() const { return kind() != MaterialKind::kDiffuse && spec_.smooth(); }
 
-  SurfaceBsdf bsdf(double lambda_nm) const;
+  SurfaceBsdf bsdf(double lambda_nm, Body body = Body::kOpaque) const;
+  // Whether light crosses this surface around a body: a dielectric solid.
+  bool transmits(Body body) const { return body == Body::kSolid && kind() == MaterialKind::kDielectric; }
   // The model the table above picks: "lambertian", "smooth_conductor",
   // "rough_conductor", "multiple_bounce_conductor", ... (dielectric, diffuse).
   std::string model_name() const;

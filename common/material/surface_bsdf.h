@@ -20,6 +20,7 @@
 #include "common/material/rough_conductor.h"
 #include "common/material/rough_dielectric.h"
 #include "common/material/rough_diffuse.h"
+#include "common/material/smooth_dielectric.h"
 #include "common/material/smooth_reflector.h"
 
 namespace skyfarm::material {
@@ -48,7 +49,12 @@ class SurfaceBsdf {
         },
         bsdf_);
   }
-  bool specular() const { return std::holds_alternative<SmoothReflector>(bsdf_); }
+  // A delta lobe (SmoothReflector, SmoothDielectric): f and pdf are not functions.
+  bool specular() const {
+    return std::holds_alternative<SmoothReflector>(bsdf_) || std::holds_alternative<SmoothDielectric>(bsdf_);
+  }
+  // The smooth interface light crosses, or null.
+  const SmoothDielectric* smooth_dielectric() const { return std::get_if<SmoothDielectric>(&bsdf_); }
 
   // A direction drawn from the proposal (density pdf(wo, .)) without
   // evaluating f: the path tracer proposes with the hero wavelength's BSDF
@@ -64,7 +70,7 @@ class SurfaceBsdf {
     double cosine_share = 0.0;
   };
   std::variant<std::monostate, Lambertian, RoughConductor, RoughDielectric, RoughDiffuse, MultipleBounceBsdf,
-               SmoothReflector>
+               SmoothReflector, SmoothDielectric>
       bsdf_;
   std::optional<Reflection> reflection_;
 };

@@ -95,6 +95,40 @@ Frame ground_frame(const glm::dvec3& n) { return surface_frame(n, glm::cross(glm
 // their estimates are correlated as the volume's are (material/bsdf.h).
 std::uint64_t bsdf_seed(Sampler& sampler) { return static_cast<std::uint64_t>(sampler.next() * 0x1.0p53); }
 
+// The power heuristic (exponent 2) in the spectral-MIS ratio form, for a
+// path x that ends on the sun after a surface vertex.  Four wavelengths,
+// each one's hero technique equally likely, and at the vertex two
+// techniques per hero: the sun's sample (light, L) and the BSDF's (B).  The
+// densities of x under the two families, over its wavelengths' heroes, are
+// the mixtures
+//   P_L(x) = (1/4) sum_k p_L,k(x),   P_B(x) = (1/4) sum_k p_B,k(x),
+// and pbrt-v4's ratios are them over a reference density p_ref (the hero's
+// density of the path up to the vertex times the hero's technique's at it):
+//   avg(r_l) = P_L / p_ref,   avg(r_u) = P_B / p_ref.
+// The hero is a one-sample choice among the four: a sample x drawn by the
+// hero's technique of family s, weighed g(x) / P_s(x), has expectation
+// integral g (the mixture's density is P_s), whatever the hero; the
+// balance heuristic's f w_s / P_s with w_s = P_s / (P_L + P_B) is the
+// integrator's beta f T Le / avg(r_l + r_u).  Both families sample once at
+// every vertex, so any weights with w_L(x) + w_B(x) = 1 on every path keep
+// the sum unbiased; the power heuristic's w_s = P_s^2 / (P_L^2 + P_B^2) are
+// such weights, and the contribution of the family s that drew x is
+//   F w_s / P_s = F P_s / (P_L^2 + P_B^2) = (F / p_ref) R_s / (R_L^2 + R_B^2),
+// F / p_ref the path's throughput times the sun's radiance (the balance
+// form's numerator) and R_L = avg(r_l), R_B = avg(r_u): the reference
+// cancels, as it must.  The spectral combination stays the balance (the
+// mixture over heroes: a one-sample choice), the heuristic between the two
+// techniques becomes the power.  Each side computes R_L and R_B in its own
+// reference (the NEE's at the vertex, the BSDF sample's where it meets the
+// sun), which changes neither weight.  Returns R_s / (R_L^2 + R_B^2) for
+// the family s whose ratio is r_s, scaled so that no square overflows.
+double power_weight(double r_s, double r_other) {
+  const double m = std::max(r_s, r_other);
+  if (!(m > 0.0) || !std::isfinite(m)) return 0.0;
+  const double a = r_s / m, b = r_other / m;
+  return a / (m * (a * a + b * b));
+}
+
 }  // namespace
 
 // A scattering vertex: in the medium (phase function) or on the ground (Lambert).
@@ -184,6 +218,12 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         extent.t_end = extent.object->t;
         extent.hits_ground = false;
       }
+    }
+    if (st.in_solid) {
+      // Inside a solid object: straight to its surface, nothing in between.
+      // A ray that misses it has slipped out through round-off: lost.
+      if (!extent.object || !finish_segment(extent, c, depth, &ray, &st, &L)) return L;
+      continue;
     }
     bool scattered = false, absorbed = false;
     // --- The sun scattered once along this segment, sampled where it is lit:
@@ -317,6 +357,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       continue;
     }
     st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
+    st.mis_power = false;
     st.sun_from_segment_estimator = explicit_single;
     if (!survives(&st, ray.o, ray.d, depth, c, &L)) return L;
   }
@@ -425,11 +466,14 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const PathCoefficients& path = c.path;
   if (st->beta.is_zero()) return false;
   if (extent.object) {
-    // Two-sided: the side the ray came from.
+    // Two-sided: the side the ray came from; a solid that light crosses
+    // keeps its outward normal (the ray may come from inside).
     const SurfaceHit& hit = *extent.object;
-    const glm::dvec3 n = glm::dot(hit.n, ray->d) < 0.0 ? hit.n : -hit.n;
-    return bounce_on_surface(*hit.surface, hit.p + n * hit.offset_m, surface_frame(n, hit.tangent), c, depth, ray,
-                             st, L);
+    const material::Body body = hit.solid ? material::Body::kSolid : material::Body::kOpaque;
+    const glm::dvec3 n =
+        hit.surface->transmits(body) || glm::dot(hit.n, ray->d) < 0.0 ? hit.n : -hit.n;
+    return bounce_on_surface(*hit.surface, body, hit.p + n * hit.offset_m, hit.p - n * hit.offset_m,
+                             surface_frame(n, hit.tangent), c, depth, ray, st, L);
   }
   if (!extent.hits_ground) {
     const bool sun_is_segment_estimators = st->sun_from_segment_estimator;
@@ -439,7 +483,10 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
         *L += st->beta * Le * (1.0 / st->r_u.average());
       } else {
         const SampledSpectrum r_l = st->r_l * sun.pdf(ray->d);
-        *L += st->beta * Le * (1.0 / (st->r_u + r_l).average());
+        if (st->mis_power)
+          *L += st->beta * Le * power_weight(st->r_u.average(), r_l.average());
+        else
+          *L += st->beta * Le * (1.0 / (st->r_u + r_l).average());
       }
     }
     if (scene_.environment_radiance > 0.0)
@@ -448,8 +495,9 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   }
   if (scene_.ground_surface()) {
     const glm::dvec3 n = glm::normalize(ray->at(extent.t_end));
-    return bounce_on_surface(*scene_.ground_surface(), n * (scene_.atmosphere().planet_radius_m() + kGroundOffset_m),
-                             ground_frame(n), c, depth, ray, st, L);
+    const glm::dvec3 p = n * (scene_.atmosphere().planet_radius_m() + kGroundOffset_m);
+    return bounce_on_surface(*scene_.ground_surface(), material::Body::kOpaque, p, p, ground_frame(n), c, depth, ray,
+                             st, L);
   }
   // --- Lambertian ground: sun NEE, then cosine-weighted continuation.
   const Atmosphere& atmosphere = scene_.atmosphere();
@@ -464,19 +512,50 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->beta *= path.ground_albedo;
   st->r_l = st->r_u * (1.0 / pdf);
   st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
+  st->mis_power = false;
   st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
   return survives(st, p, wi, depth, c, L);
 }
 
-// A ground that is a material: sun NEE with MIS (unless the surface is
-// smooth: a delta lobe the sun's samples never meet), then the next direction
-// proposed by the hero wavelength's BSDF.  Every wavelength's f is an
-// unbiased estimate (stochastic for the multiple-bounce forms) and its pdf
-// the deterministic density its own proposal would have had, so the spectral
-// MIS ratios r_u are built from pdfs alone (material/bsdf.h says why that
-// keeps MIS unbiased).  A direction below the surface is light that entered
-// it (a dielectric's transmission): absorbed, the path ends.
+// A surface that is a material (the ground, an object): sun NEE with MIS
+// (unless the surface is smooth: a delta lobe the sun's samples never
+// meet), then the next direction proposed by the hero wavelength's BSDF.
+// Every wavelength's f is an unbiased estimate (stochastic for the
+// multiple-bounce forms) and its pdf the deterministic density its own
+// proposal would have had, so the spectral MIS ratios r_u are built from
+// pdfs alone (material/bsdf.h says why that keeps MIS unbiased).
+//
+// Opaque bodies (the ground, sheets, every conductor and diffuse solid): the
+// frame faces the ray, and a direction below the surface is light that
+// entered it (a dielectric's transmission): absorbed, the path ends.
+//
+// A solid that light crosses (a glass object, material::Body::kSolid): the
+// frame's z is the OUTWARD normal and wo is on either side (the BSDFs of a
+// transmitting surface take wo inside: the relative index inverts).  A
+// direction below leaves from p_below into the body, where the path meets
+// nothing but the body's surface again (PathState::in_solid).  The sun's
+// NEE is made towards directions above only (from p_above): one below
+// would cross the body, which blocks it.  The crossings carry no radiance
+// factor (n_wo/n_wi)^2 (material/surface.h): every path starts (the
+// camera) and ends (the sun, the sky) outside the bodies, entering and
+// leaving each through its surface, so the factors would cancel anyway.
+//
+// A smooth dielectric picks its lobe (reflect, refract) with the hero's
+// Fresnel probability; each wavelength's weight and r_u take its own F
+// (spectral MIS over the discrete choice).  A refraction whose index differs
+// across the path's wavelengths sends each along its own direction
+// (dispersion): the path can follow only the hero's, so the others end there
+// (pbrt-v4's TerminateSecondary).  In this integrator's ratio form that is
+// beta_i = 0 (their light from here on) and r_u,i = r_l,i = 0: the path's
+// further vertices have density 0 under any other wavelength's technique,
+// so the hero's MIS weight 1 / avg(r_u) becomes the 4 = 1 / (1/4) of a
+// path only one technique could draw, and the light the hero gathers from
+// here on counts for the whole tuple (as the wavelength pdf divided by 4
+// does in pbrt-v4, where r_u is not zeroed; doing both would count it 4
+// times, doing neither would weigh the hero as if the others could have
+// drawn the path).  A dielectric whose index is the same at every
+// wavelength of the path keeps them all.
 //
 // f is evaluated with its arguments swapped, f(wi, wo): the multiple-bounce
 // walk starts on the viewer's side.  The height-correlated microsurface is
@@ -487,52 +566,80 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
 // Swapped, a non-absorbing ground under a uniform sky returns all its light
 // to the camera, as any closed isothermal scene must.  The reciprocal forms
 // (Lambertian, single-bounce conductor, the smooth reflector, dielectric
-// reflection) are unchanged by the swap.
-bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, const glm::dvec3& p, const Frame& frame,
-                                             const PathContext& c, int depth, Ray* ray, PathState* st,
-                                             SampledSpectrum* L) const {
+// reflection) are unchanged by the swap; a dielectric's transmission loses
+// its radiance factor by it (the transposed radiance form is the flux
+// form), as the smooth dielectric of a solid has none.
+bool VolumePathIntegrator::bounce_on_surface(const material::Surface& surface, material::Body body,
+                                             const glm::dvec3& p_above, const glm::dvec3& p_below,
+                                             const Frame& frame, const PathContext& c, int depth, Ray* ray,
+                                             PathState* st, SampledSpectrum* L) const {
   const Sun& sun = scene_.sun();
   const glm::dvec3& n = frame.n;
+  const bool crosses = surface.transmits(body);
   SurfaceVertex sv;
   sv.frame = frame;
   sv.wo = sv.frame.to_local(-ray->d);
-  if (!(sv.wo.z > 0.0)) return false;
-  for (int i = 0; i < kWavelengthsPerPath; ++i) sv.bsdf[i] = surface.bsdf(c.lambda.lambda_nm[i]);
+  if (crosses ? sv.wo.z == 0.0 : !(sv.wo.z > 0.0)) return false;
+  for (int i = 0; i < kWavelengthsPerPath; ++i) sv.bsdf[i] = surface.bsdf(c.lambda.lambda_nm[i], body);
   const bool specular = sv.bsdf[0].specular();
   const SurfaceSunSampling strategy = options_.surface_sun_sampling;
   if (scene_.sun_enabled && !specular && strategy != SurfaceSunSampling::kBsdfOnly) {
-    const Vertex v{p, ray->d, true, n, nullptr, nullptr, &c.path, &c.coarse, st->beta, st->r_u, &sv};
+    const Vertex v{p_above, ray->d, true, n, nullptr, nullptr, &c.path, &c.coarse, st->beta, st->r_u, &sv};
     *L += sample_sun(v, c.lambda, c.sampler, c.counters);
   }
   const double uc = c.sampler.next(), u0 = c.sampler.next(), u1 = c.sampler.next();
   const std::uint64_t seed = bsdf_seed(c.sampler);
-  const std::optional<glm::dvec3> proposed = sv.bsdf[0].propose(sv.wo, uc, {u0, u1});
-  if (!proposed || !(proposed->z > 0.0)) return false;
-  const glm::dvec3 wi = *proposed;
-  if (specular) {
-    // The same mirror direction whatever the hero: r_u unchanged; F per wavelength.
+  glm::dvec3 wi;
+  if (const material::SmoothDielectric* glass = sv.bsdf[0].smooth_dielectric()) {
+    material::RandomSequence unused(seed);
+    const std::optional<material::BsdfSample> hero = glass->sample(sv.wo, uc, {u0, u1}, unused);
+    if (!hero || !(hero->pdf > 0.0)) return false;
+    const bool reflect = (hero->flags & material::kBsdfReflection) != 0;
+    wi = hero->wi;
+    bool dispersed = false;
     for (int i = 0; i < kWavelengthsPerPath; ++i) {
-      material::RandomSequence unused(seed);
-      const std::optional<material::BsdfSample> s = sv.bsdf[i].get().sample(sv.wo, uc, {u0, u1}, unused);
-      st->beta[i] *= s ? s->value : 0.0;
+      const material::SmoothDielectric* own = sv.bsdf[i].smooth_dielectric();
+      const std::optional<material::SmoothDielectric::Lobe> lobe = own->lobe(sv.wo, reflect);
+      st->beta[i] *= lobe ? lobe->weight / hero->pdf : 0.0;
+      st->r_u[i] *= lobe ? lobe->probability / hero->pdf : 0.0;
+      dispersed = dispersed || (!reflect && own->eta() != glass->eta());
+    }
+    if (dispersed) {
+      for (int i = 1; i < kWavelengthsPerPath; ++i) st->beta[i] = st->r_u[i] = st->r_l[i] = 0.0;
     }
     st->mis_with_sun = false;
   } else {
-    SampledSpectrum f, pdf;
-    for (int i = 0; i < kWavelengthsPerPath; ++i) {
-      material::RandomSequence rng(seed);
-      f[i] = sv.bsdf[i].get().f(wi, sv.wo, rng);
-      pdf[i] = sv.bsdf[i].pdf(sv.wo, wi);
+    const std::optional<glm::dvec3> proposed = sv.bsdf[0].propose(sv.wo, uc, {u0, u1});
+    if (!proposed || !(crosses ? proposed->z != 0.0 : proposed->z > 0.0)) return false;
+    wi = *proposed;
+    if (specular) {
+      // The same mirror direction whatever the hero: r_u unchanged; F per wavelength.
+      for (int i = 0; i < kWavelengthsPerPath; ++i) {
+        material::RandomSequence unused(seed);
+        const std::optional<material::BsdfSample> s = sv.bsdf[i].get().sample(sv.wo, uc, {u0, u1}, unused);
+        st->beta[i] *= s ? s->value : 0.0;
+      }
+      st->mis_with_sun = false;
+    } else {
+      SampledSpectrum f, pdf;
+      for (int i = 0; i < kWavelengthsPerPath; ++i) {
+        material::RandomSequence rng(seed);
+        f[i] = sv.bsdf[i].get().f(wi, sv.wo, rng);
+        pdf[i] = sv.bsdf[i].pdf(sv.wo, wi);
+      }
+      const double pdf_hero = pdf[0];
+      if (!(pdf_hero > 0.0)) return false;
+      st->r_l = st->r_u * (1.0 / pdf_hero);
+      st->beta *= f * (std::abs(wi.z) / pdf_hero);
+      st->r_u *= pdf * (1.0 / pdf_hero);
+      st->mis_with_sun = scene_.sun_enabled && !sun.is_point() && strategy == SurfaceSunSampling::kMis;
+      st->mis_power = options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower;
     }
-    const double pdf_hero = pdf[0];
-    if (!(pdf_hero > 0.0)) return false;
-    st->r_l = st->r_u * (1.0 / pdf_hero);
-    st->beta *= f * (wi.z / pdf_hero);
-    st->r_u *= pdf * (1.0 / pdf_hero);
-    st->mis_with_sun = scene_.sun_enabled && !sun.is_point() && strategy == SurfaceSunSampling::kMis;
   }
   // Sun only: the disk met by the BSDF's direction is NEE's alone.
   st->sun_from_segment_estimator = strategy == SurfaceSunSampling::kSunOnly && !specular;
+  st->in_solid = crosses && wi.z < 0.0;
+  const glm::dvec3 p = st->in_solid ? p_below : p_above;
   const glm::dvec3 wi_world = glm::normalize(sv.frame.to_world(wi));
   *ray = Ray{p, wi_world};
   return survives(st, p, wi_world, depth, c, L);
@@ -698,6 +805,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
     return Ld * (1.0 / r_l.average());
   const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
+  if (v.surface && options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower)
+    return Ld * power_weight(r_l.average(), r_u.average());
   return Ld * (1.0 / (r_l + r_u).average());
 }
 

@@ -53,10 +53,17 @@ class ShadowGuide;
 // object): by next-event estimation and BSDF sampling combined by MIS (the
 // renderer's), or by one of them alone (the MIS tests compare the three).
 enum class SurfaceSunSampling { kMis, kSunOnly, kBsdfOnly };
+// The MIS weights at a surface vertex (SurfaceSunSampling::kMis): Veach's
+// balance or power (exponent 2) heuristic between the sun's and the BSDF's
+// samples (the .cpp, above sample_sun, derives the power heuristic in the
+// spectral-MIS ratio form).  Medium vertices and the Lambertian ground
+// always use the balance heuristic.
+enum class SurfaceMisHeuristic { kBalance, kPower };
 
 struct IntegratorOptions {
   int max_depth = 10000;
   SurfaceSunSampling surface_sun_sampling = SurfaceSunSampling::kMis;
+  SurfaceMisHeuristic surface_mis_heuristic = SurfaceMisHeuristic::kPower;
   int rr_start_depth = 2;
   // Russian roulette plays on a throughput below this at vertices in the
   // planet's shadow (1 elsewhere), and survivors carry it: a twilight path
@@ -191,9 +198,15 @@ class VolumePathIntegrator {
   struct PathState {
     SampledSpectrum beta{1.0}, r_u{1.0}, r_l{1.0};
     bool mis_with_sun = false;           // the previous vertex sampled the sun (NEE)
+    bool mis_power = false;              // ... with the power heuristic (a surface vertex)
     // The ray leaves a medium vertex whose segment's sun light came from the
     // sunlit-segment estimator (so the sun disk seen next is not counted).
     bool sun_from_segment_estimator = false;
+    // The ray runs inside a solid object it entered by refraction (glass):
+    // no atmosphere there (no collisions, no sun), and its segment ends on
+    // the object's surface.  Set at every surface vertex from the side the
+    // next direction leaves on; no other vertex is reached inside.
+    bool in_solid = false;
   };
   // What stays fixed along one path.
   struct PathContext {
@@ -218,10 +231,15 @@ class VolumePathIntegrator {
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
   // A surface that is a material (the ground's when it is not Lambertian, an
-  // object's) at p (already off the surface on the ray's side), its local
-  // frame's z the normal on that side: sun NEE, then the next direction.
-  bool bounce_on_surface(const material::Surface& surface, const glm::dvec3& p, const Frame& frame,
-                         const PathContext& c, int depth, Ray* ray, PathState* st, SampledSpectrum* L) const;
+  // object's) around a body (material::Body), its local frame's z the normal
+  // on the ray's side or, for a solid that light crosses, the outward one:
+  // sun NEE, then the next direction.  p_above and p_below are the surface
+  // point already off the surface on either side of the frame's z: rays
+  // leaving above start at p_above (and the sun's shadow rays), rays leaving
+  // below at p_below (only a surface that light crosses has them).
+  bool bounce_on_surface(const material::Surface& surface, material::Body body, const glm::dvec3& p_above,
+                         const glm::dvec3& p_below, const Frame& frame, const PathContext& c, int depth, Ray* ray,
+                         PathState* st, SampledSpectrum* L) const;
   // Russian roulette after the vertex at p whose next direction is wi (the
   // control variate adds to *L, the light this path has gathered so far).
   bool survives(PathState* st, const glm::dvec3& p, const glm::dvec3& wi, int depth, const PathContext& c,

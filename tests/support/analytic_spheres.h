@@ -19,6 +19,7 @@ class AnalyticSpheres final : public SceneObjects {
     glm::dvec3 centre_enu;  // m, from the observer
     double radius_m;
     const material::Surface* surface;
+    bool solid = true;  // false: a two-sided sheet (opaque whatever its material)
   };
 
   AnalyticSpheres(glm::dvec3 observer, std::vector<Sphere> spheres)
@@ -43,6 +44,7 @@ class AnalyticSpheres final : public SceneObjects {
         h.tangent = std::abs(h.n.z) < 0.999 ? glm::normalize(glm::cross(glm::dvec3(0, 0, 1), h.n)) : glm::dvec3(1, 0, 0);
         h.surface = s.surface;
         h.offset_m = 1e-7 * std::max(1.0, s.radius_m);
+        h.solid = s.solid;
         best = h;
         break;
       }

@@ -161,9 +161,11 @@ TEST(ObjectTransport, ChromeBallReflectsTheSkyOfTheMirrorDirection) {
 struct PathMoments {
   double mean = 0.0, variance = 0.0;
 };
-PathMoments moments(const Scene& scene, const glm::dvec3& view, SurfaceSunSampling strategy, int n) {
+PathMoments moments(const Scene& scene, const glm::dvec3& view, SurfaceSunSampling strategy, int n,
+                    SurfaceMisHeuristic heuristic = SurfaceMisHeuristic::kBalance) {
   IntegratorOptions options;
   options.surface_sun_sampling = strategy;
+  options.surface_mis_heuristic = heuristic;
   const VolumePathIntegrator integrator(scene, options);
   SampledWavelengths wl;
   wl.lambda_nm.fill(550.0);
@@ -181,11 +183,15 @@ PathMoments moments(const Scene& scene, const glm::dvec3& view, SurfaceSunSampli
 }
 
 // MIS at a surface (Veach 1997, ch. 9): sun-only, BSDF-only and their MIS
-// combination (the balance heuristic) estimate the same radiance of a rough
-// gold sphere under the sun in vacuum, near its highlight, for a sharp, a
-// medium and a broad lobe (broader ones need millions of BSDF samples to
-// meet the sun at all); MIS stays within Veach's bound of the better
-// technique and far below the worse one.
+// combinations (the balance and the power heuristic) estimate the same
+// radiance of a rough gold sphere under the sun in vacuum, near its
+// highlight, for a sharp, a medium and a broad lobe (broader ones need
+// millions of BSDF samples to meet the sun at all); MIS stays within Veach's
+// bound of the better technique and far below the worse one.  The power
+// heuristic (the same paths) is far quieter than the balance where one
+// technique is much the better (the broad lobe: sun sampling; 60x lower
+// variance measured) and within 25 % of it where the two are alike (the
+// sharp lobe, whose solid angle is near the sun's: 10 % higher measured).
 TEST(ObjectTransport, SunOnlyBsdfOnlyAndMisAgreeOnARoughMetalSphereWithinVeachsBound) {
   for (double alpha : {0.002, 0.02, 0.1}) {
     Scene scene = Scene::from_specs(testing::thin_hg_layer(1e-12, 1000.0, 0.0), testing::sun_spec(45.0, 0.0),
@@ -210,12 +216,21 @@ TEST(ObjectTransport, SunOnlyBsdfOnlyAndMisAgreeOnARoughMetalSphereWithinVeachsB
     const glm::dvec3 view = glm::normalize(spot);
     const int n = 40000;
     const PathMoments mis = moments(scene, view, SurfaceSunSampling::kMis, n);
+    const PathMoments power = moments(scene, view, SurfaceSunSampling::kMis, n, SurfaceMisHeuristic::kPower);
     const PathMoments sun = moments(scene, view, SurfaceSunSampling::kSunOnly, n);
     const PathMoments bsdf = moments(scene, view, SurfaceSunSampling::kBsdfOnly, n);
     const double se = std::sqrt(mis.variance / n);
     ASSERT_GT(mis.mean, 0.0) << alpha;
     EXPECT_NEAR(sun.mean, mis.mean, 4.0 * std::hypot(se, std::sqrt(sun.variance / n))) << "alpha " << alpha;
     EXPECT_NEAR(bsdf.mean, mis.mean, 4.0 * std::hypot(se, std::sqrt(bsdf.variance / n))) << "alpha " << alpha;
+    EXPECT_NEAR(power.mean, sun.mean, 4.0 * std::hypot(std::sqrt(power.variance / n), std::sqrt(sun.variance / n)))
+        << "alpha " << alpha;
+    EXPECT_NEAR(power.mean, bsdf.mean, 4.0 * std::hypot(std::sqrt(power.variance / n), std::sqrt(bsdf.variance / n)))
+        << "alpha " << alpha;
+    EXPECT_LE(power.variance, 1.25 * mis.variance) << "alpha " << alpha;
+    if (alpha >= 0.1) {
+      EXPECT_LT(power.variance, 0.5 * mis.variance) << "alpha " << alpha;
+    }
     // Veach's bound for the balance heuristic with one sample of each
     // technique (Veach 1997, theorem 9.2): V_MIS <= V_best + (1 - 1/2) mu^2.
     EXPECT_LE(mis.variance, std::min(sun.variance, bsdf.variance) + 0.5 * mis.mean * mis.mean)
@@ -223,8 +238,10 @@ TEST(ObjectTransport, SunOnlyBsdfOnlyAndMisAgreeOnARoughMetalSphereWithinVeachsB
     // Where one technique fails (a sun sample under a mirror-sharp lobe, a
     // BSDF sample towards a small sun under a broad one), MIS does not.
     EXPECT_LT(mis.variance, std::max(sun.variance, bsdf.variance) / 4.0) << "alpha " << alpha;
-    std::printf("alpha %.2f: L %.4g (sun %.4g, BSDF %.4g); variance per path MIS %.3g, sun only %.3g, BSDF only %.3g\n", alpha, mis.mean, sun.mean, bsdf.mean,
-                mis.variance, sun.variance, bsdf.variance);
+    std::printf("alpha %.3f: L %.4g (power %.4g, sun %.4g, BSDF %.4g); variance per path balance %.3g, power %.3g, "
+                "sun only %.3g, BSDF only %.3g\n",
+                alpha, mis.mean, power.mean, sun.mean, bsdf.mean, mis.variance, power.variance, sun.variance,
+                bsdf.variance);
   }
 }
 
