@@ -35,6 +35,21 @@ bool mesh_is_closed(const assets::TriangleMesh& mesh) {
   return std::all_of(edges.begin(), edges.end(), [](const auto& e) { return e.second == 2; });
 }
 
+// The signed volume a closed mesh encloses (divergence theorem over its
+// triangles): negative when its triangles are wound clockwise seen from
+// outside, i.e. their normals point in.
+double signed_volume(const assets::TriangleMesh& mesh) {
+  double v = 0.0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const auto p = [&](int k) {
+      const std::size_t i = mesh.indices[3 * t + k];
+      return glm::dvec3(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]);
+    };
+    v += glm::dot(p(0), glm::cross(p(1), p(2)));
+  }
+  return v / 6.0;
+}
+
 // The radius of the sphere about the origin around each unit shape.
 double unit_bound(ShapeKind shape) {
   switch (shape) {
@@ -117,7 +132,11 @@ PlacedObjects::PlacedObjects(const std::vector<ObjectSpec>& specs, double ground
           a.positions.emplace_back(mesh->positions[3 * v], mesh->positions[3 * v + 1], mesh->positions[3 * v + 2]);
         a.indices = mesh->indices;
         arrays.push_back(std::move(a));
-        mesh_closed_.push_back(mesh_is_closed(*mesh));
+        const bool closed = mesh_is_closed(*mesh);
+        mesh_closed_.push_back(closed);
+        // A solid's normal must point out of it (glass bends light by which
+        // side it comes from); files wound the other way are turned.
+        mesh_inward_.push_back(closed && signed_volume(*mesh) < 0.0);
         meshes_.push_back(std::move(mesh));
       }
       o.mesh = it->second;
@@ -172,6 +191,7 @@ std::optional<PlacedObjects::ObjectHit> PlacedObjects::closest(const Ray& enu, d
       s.p = b0 * p0 + b1 * p1 + b2 * p2;
       s.p_error = rounding_gamma(7) * (glm::abs(b0 * p0) + glm::abs(b1 * p1) + glm::abs(b2 * p2));
       s.n = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+      if (mesh_inward_[o.mesh]) s.n = -s.n;
       s.uv = {b1, b2};
       s.primitive = h->primitive;
       best = ObjectHit{o.to_enu.to_parent(s), i};

@@ -17,7 +17,8 @@
 //
 // Hits.  n is the outward geometric normal (the +z side of a disc or a
 // rectangle, the counter-clockwise side of a triangle), carried by the
-// inverse transpose (a mirroring scale keeps it outward); tangent is the
+// inverse transpose (a mirroring scale keeps it outward; a closed mesh wound
+// clockwise from outside has its normals turned out); tangent is the
 // object's x axis made perpendicular to n (its y axis where x is along n):
 // the roughness_x direction of an anisotropic material.  solid says whether
 // the object encloses a volume (sphere, box, a mesh whose every edge is
@@ -79,6 +80,7 @@ class PlacedObjects final : public SceneObjects {
   std::vector<std::size_t> instance_of_;  // BVH instance -> object
   std::vector<std::shared_ptr<const assets::TriangleMesh>> meshes_;
   std::vector<bool> mesh_closed_;
+  std::vector<bool> mesh_inward_;  // closed, wound clockwise from outside: normals flipped
   std::unique_ptr<accel::TriangleBvh> bvh_;
   std::size_t triangles_ = 0;
 };

@@ -216,6 +216,27 @@ TEST(PlacedObjects, SolidsAndSheets) {
   }
 }
 
+// A closed mesh wound inside out (every triangle reversed) still has its
+// normals pointing out of the solid: glass depends on it.
+TEST(PlacedObjects, AClosedMeshWoundInsideOutHasOutwardNormals) {
+  const TriangleMesh ico = icosphere(2);
+  std::vector<std::uint32_t> reversed = ico.indices();
+  for (std::size_t t = 0; t < reversed.size(); t += 3) std::swap(reversed[t + 1], reversed[t + 2]);
+  MemoryMeshes meshes;
+  const std::string inside_out = "sha256:" + std::string(64, 'd');
+  meshes.add(kIco, ico);
+  meshes.add(inside_out, TriangleMesh(ico.positions(), reversed));
+  for (const std::string& id : {kIco, inside_out}) {
+    const PlacedObjects placed({object(ShapeKind::kMesh, {0, 10, 1}, glm::dvec3(1.0), {0, 0, 0}, id)}, kR, &meshes);
+    for (const Ray& ray : rays_towards({0, 10, 1}, 0.3, 200, 5)) {
+      const auto h = placed.intersect(ray, 1e6);
+      ASSERT_TRUE(h);
+      EXPECT_TRUE(h->solid);
+      EXPECT_GT(glm::dot(h->n, h->p - glm::dvec3(0, 10, 1 + kR)), 0.0) << id;
+    }
+  }
+}
+
 TEST(PlacedObjects, AMeshWithoutItsAssetNamesTheObject) {
   MemoryMeshes meshes;
   try {
