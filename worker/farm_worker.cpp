@@ -413,6 +413,7 @@ std::optional<SessionEnd> FarmWorker::Impl::handle(zmq::socket_t& socket, const 
     abandon_units();
     if (draining_) return SessionEnd::kDrained;  // the server holds nothing of ours
     send_ready(socket);
+    asset_requests.resend_all();  // an unregistered worker's questions were not answered
   } else {
     ++counters.malformed;  // READY, RESULT, FAILED: not for a worker
   }
