@@ -70,11 +70,12 @@
 // version 3 worker would fail every unit whose request has objects); the
 // server refuses another version with a fatal DISCONNECT.  CURVE changed no
 // message (version 3 then): an older worker fails the handshake (NULL
-// mechanism) before any READY, which is the refusal it gets.  Decoding is strict: an unknown command, a
-// header that is not a JSON object, a missing or mistyped field, a value out
-// of range or a wrong frame count throws WireError (the receivers count such
-// messages and drop them; nothing here trusts the peer).  Unknown extra
-// header fields are ignored, so later versions may add fields.
+// mechanism) before any READY, which is the refusal it gets.  Decoding is
+// strict: an unknown command, a header that is not a JSON object, a missing
+// or mistyped field, a value out of range or a wrong frame count throws
+// WireError (the receivers count such messages and drop them; nothing here
+// trusts the peer).  Unknown extra header fields are ignored, so later
+// versions may add fields.
 #pragma once
 #include <cstddef>
 #include <cstdint>
