@@ -5,6 +5,8 @@
 #include <limits>
 #include <type_traits>
 
+#include "common/assets/asset_id.h"
+
 namespace skyfarm::api {
 namespace {
 
@@ -12,7 +14,7 @@ using Json = nlohmann::json;
 
 constexpr int kMaxHeaderDepth = 32;
 
-constexpr std::array<std::pair<Command, std::string_view>, 8> kCommandNames{{
+constexpr std::array<std::pair<Command, std::string_view>, 10> kCommandNames{{
     {Command::kReady, "READY"},
     {Command::kHeartbeat, "HEARTBEAT"},
     {Command::kUnit, "UNIT"},
@@ -21,6 +23,8 @@ constexpr std::array<std::pair<Command, std::string_view>, 8> kCommandNames{{
     {Command::kCancel, "CANCEL"},
     {Command::kDisconnect, "DISCONNECT"},
     {Command::kReregister, "REREGISTER"},
+    {Command::kAssetGet, "ASSET_GET"},
+    {Command::kAsset, "ASSET"},
 }};
 
 [[noreturn]] void fail(const std::string& what) { throw WireError(what); }
@@ -179,6 +183,16 @@ Json header_of(const DisconnectMsg& m) {
   return h;
 }
 Json header_of(const ReregisterMsg&) { return Json::object(); }
+Json header_of(const AssetGetMsg& m) { return Json{{"id", m.id}}; }
+Json header_of(const AssetMsg& m) {
+  Json h{{"id", m.id}, {"ok", m.ok}};
+  if (!m.ok) {
+    std::string text = m.error.substr(0, kMaxMessageBytes);
+    if (text.empty()) text = "unknown error";
+    h["error"] = text;
+  }
+  return h;
+}
 
 ReadyMsg read_ready(const Json& h) {
   ReadyMsg m;
@@ -251,6 +265,30 @@ DisconnectMsg read_disconnect(const Json& h) {
   return m;
 }
 
+std::string read_asset_id(const Json& h) {
+  std::string id = get_string(h, "id", kMaxIdBytes);
+  if (!assets::is_asset_id(id)) fail("\"id\" must be sha256: and 64 lowercase hex digits");
+  return id;
+}
+AssetGetMsg read_asset_get(const Json& h) { return AssetGetMsg{read_asset_id(h)}; }
+AssetMsg read_asset(const Json& h, const Frames& frames) {
+  AssetMsg m;
+  m.id = read_asset_id(h);
+  const Json* ok = field(h, "ok", true);
+  if (!ok->is_boolean()) fail("\"ok\" must be a boolean");
+  m.ok = ok->get<bool>();
+  if (m.ok) {
+    if (frames.size() != 3 || frames[2].empty()) fail("ASSET with ok needs the mesh file as a payload frame");
+    if (frames[2].size() > kMaxAssetBytes)
+      fail("ASSET payload larger than " + std::to_string(kMaxAssetBytes) + " bytes");
+    m.file = frames[2];
+  } else {
+    if (frames.size() != 2) fail("ASSET without ok has no payload frame");
+    m.error = get_string(h, "error", kMaxMessageBytes);
+  }
+  return m;
+}
+
 }  // namespace
 
 std::string_view command_name(Command command) {
@@ -276,7 +314,9 @@ Command command_of(const Message& message) {
         else if constexpr (std::is_same_v<T, FailedMsg>) return Command::kFailed;
         else if constexpr (std::is_same_v<T, CancelMsg>) return Command::kCancel;
         else if constexpr (std::is_same_v<T, DisconnectMsg>) return Command::kDisconnect;
-        else return Command::kReregister;
+        else if constexpr (std::is_same_v<T, ReregisterMsg>) return Command::kReregister;
+        else if constexpr (std::is_same_v<T, AssetGetMsg>) return Command::kAssetGet;
+        else return Command::kAsset;
       },
       message);
 }
@@ -286,6 +326,7 @@ Frames encode(const Message& message) {
   frames.emplace_back(command_name(command_of(message)));
   frames.push_back(std::visit([](const auto& m) { return header_of(m).dump(); }, message));
   if (const auto* r = std::get_if<ResultMsg>(&message)) frames.push_back(r->film_tile);
+  if (const auto* a = std::get_if<AssetMsg>(&message); a && a->ok) frames.push_back(a->file);
   return frames;
 }
 
@@ -293,7 +334,7 @@ Message decode(const Frames& frames) {
   if (frames.empty()) fail("empty message");
   const std::optional<Command> command = command_from_name(frames[0]);
   if (!command) fail("unknown command \"" + frames[0].substr(0, 32) + "\"");
-  const std::size_t expected = *command == Command::kResult ? 3 : 2;
+  const std::size_t expected = *command == Command::kResult || *command == Command::kAsset ? 3 : 2;
   if (frames.size() > expected) fail("too many frames for " + std::string(command_name(*command)));
   if (*command == Command::kResult && frames.size() != 3) fail("RESULT needs a header and a payload frame");
   const Json header = parse_header(frames.size() > 1 ? frames[1] : std::string());
@@ -306,6 +347,8 @@ Message decode(const Frames& frames) {
     case Command::kCancel: return read_cancel(header);
     case Command::kDisconnect: return read_disconnect(header);
     case Command::kReregister: return ReregisterMsg{};
+    case Command::kAssetGet: return read_asset_get(header);
+    case Command::kAsset: return read_asset(header, frames);
   }
   fail("unknown command");
 }

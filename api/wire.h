@@ -4,14 +4,14 @@
 // key in the server's ZAP handler: api/curve_keys.h, server/broker/broker.h), so
 // everything below rides inside CURVE.  A DEALER sends and receives
 //
-//     [command] [header JSON object] [payload]        (payload: RESULT only)
+//     [command] [header JSON object] [payload]        (payload: RESULT, ASSET only)
 //
 // and the ROUTER sees the peer's routing identity as an extra first frame
 // (server/broker/broker.cpp strips and adds it; this file never sees it).  The
 // command frame is the ASCII name below; the header is a JSON object (an
 // empty header frame, or none at all, reads as {} for commands without
 // required fields); results travel as binary FilmTile::serialize() bytes,
-// never as JSON floats.
+// never as JSON floats, and assets as their mesh file's bytes.
 //
 //   command     direction        header fields                                  payload
 //   READY       worker -> server id, cores, slots, version, capabilities,      -
@@ -28,6 +28,8 @@
 //   CANCEL      server -> worker attempt                                        -
 //   DISCONNECT  both ways        reason?, fatal? (server: do not reconnect)     -
 //   REREGISTER  server -> worker -  (the server does not know this peer: READY) -
+//   ASSET_GET   worker -> server id ("sha256:<64 hex>")                         -
+//   ASSET       server -> worker id, ok, error? (ok false: why)                 the mesh file (ok only)
 //
 // Unit kinds: "render" (kind absent) is a render unit (tile, batch, pass of
 // the job's RenderPlan) answered with FilmTile bytes.  "probe" is a unit of a
@@ -50,17 +52,30 @@
 // the pixels of each parity of x + y (RenderPlan::sample_range,
 // common/render/sample_allocation.h); absent: the plan's uniform count.
 //
+// Assets: a UNIT's request may name mesh assets by id (its "objects").  A
+// worker that lacks one asks with ASSET_GET and the server answers ASSET:
+// with ok, the canonical mesh file (common/assets/mesh_file.h, at most
+// kMaxAssetBytes) as the payload frame, which the worker checks against the
+// id (its SHA-256) before using it; without ok, no payload and "error", a
+// sentence (the asset is not in the server's store).  An ASSET_GET is not a
+// unit's answer: the worker's units wait for the asset, their RESULT or
+// FAILED follows.  Only a registered worker is answered (others get
+// REREGISTER); a worker asks once per asset it has no copy of, and again
+// only when no answer came (a timeout, a new connection).
+//
 // Versioning: READY carries kProtocolVersion (2 since samples_per_pass: a
 // version 1 worker would ignore it and render the wrong samples; 3 since the
 // pooled ground of an observer at 0 m, render_plan.h: a version 2 worker
-// would trace every sample of those pixels); the server refuses another
-// version with a fatal DISCONNECT.  CURVE changed no message, so the version
-// stays 3: an older worker fails the handshake (NULL mechanism) before any
-// READY, which is the refusal it gets.  Decoding is strict: an unknown command, a
-// header that is not a JSON object, a missing or mistyped field, a value out
-// of range or a wrong frame count throws WireError (the receivers count such
-// messages and drop them; nothing here trusts the peer).  Unknown extra
-// header fields are ignored, so later versions may add fields.
+// would trace every sample of those pixels; 4 since ASSET_GET / ASSET: a
+// version 3 worker would fail every unit whose request has objects); the
+// server refuses another version with a fatal DISCONNECT.  CURVE changed no
+// message (version 3 then): an older worker fails the handshake (NULL
+// mechanism) before any READY, which is the refusal it gets.  Decoding is
+// strict: an unknown command, a header that is not a JSON object, a missing
+// or mistyped field, a value out of range or a wrong frame count throws
+// WireError (the receivers count such messages and drop them; nothing here
+// trusts the peer).  Unknown extra header fields are ignored, so later
+// versions may add fields.
 #pragma once
 #include <cstddef>
 #include <cstdint>
@@ -75,7 +90,7 @@
 
 namespace skyfarm::api {
 
-inline constexpr int kProtocolVersion = 3;
+inline constexpr int kProtocolVersion = 4;
 // The READY capability "probe" of a worker that runs probe units.
 inline constexpr int kProbeUnitsVersion = 1;
 
@@ -87,6 +102,11 @@ inline constexpr std::size_t kMaxMessageBytes = 64u << 10;  // FAILED text (long
 inline constexpr int kMaxSlots = 1024;
 inline constexpr int kMaxSamplesPerPass = 1 << 20;
 inline constexpr std::size_t kMaxAllocationBlocks = 1 << 16;
+// The largest mesh file an ASSET carries: the file of a mesh at the default
+// MeshLimits (2 M triangles, 6 M vertices), 168 MB.  It is more than the
+// broker's 64 MiB inbound limit, which applies to what workers send; a
+// worker's socket takes frames this large (farm_worker.cpp).
+inline constexpr std::size_t kMaxAssetBytes = 16 + 24 * std::size_t{6'000'000} + 12 * std::size_t{2'000'000};
 
 // One ZeroMQ message: its frames as byte strings (identity frame excluded).
 using Frames = std::vector<std::string>;
@@ -96,7 +116,18 @@ class WireError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class Command { kReady, kHeartbeat, kUnit, kResult, kFailed, kCancel, kDisconnect, kReregister };
+enum class Command {
+  kReady,
+  kHeartbeat,
+  kUnit,
+  kResult,
+  kFailed,
+  kCancel,
+  kDisconnect,
+  kReregister,
+  kAssetGet,
+  kAsset
+};
 
 std::string_view command_name(Command command);
 std::optional<Command> command_from_name(std::string_view name);
@@ -169,8 +200,21 @@ struct ReregisterMsg {
   bool operator==(const ReregisterMsg&) const = default;
 };
 
-using Message =
-    std::variant<ReadyMsg, HeartbeatMsg, UnitMsg, ResultMsg, FailedMsg, CancelMsg, DisconnectMsg, ReregisterMsg>;
+struct AssetGetMsg {
+  std::string id;  // "sha256:<64 hex>" (common/assets/asset_id.h)
+  bool operator==(const AssetGetMsg&) const = default;
+};
+
+struct AssetMsg {
+  std::string id;
+  bool ok = false;
+  std::string error;  // when not ok: why the server has no such asset
+  std::string file;   // when ok: the canonical mesh file's bytes (not checked here)
+  bool operator==(const AssetMsg&) const = default;
+};
+
+using Message = std::variant<ReadyMsg, HeartbeatMsg, UnitMsg, ResultMsg, FailedMsg, CancelMsg, DisconnectMsg,
+                             ReregisterMsg, AssetGetMsg, AssetMsg>;
 
 Command command_of(const Message& message);
 

@@ -155,7 +155,13 @@ int main(int argc, char** argv) {
     timelapse_options.max_frames = options.max_timelapse_frames;
     TimelapseService timelapses(service, options.data_dir, timelapse_options);
 
+    AssetStoreOptions asset_options;
+    asset_options.import.command = {"/proc/self/exe", "import-mesh"};
+    AssetStore assets(options.data_dir, asset_options);
+
     BrokerOptions broker_options;
+    // Workers fetch the mesh assets their units name (ASSET_GET, api/wire.h).
+    broker_options.asset_file = [&assets](const std::string& id) { return assets.mesh_file(id); };
     broker_options.endpoint = options.broker;
     broker_options.curve_secret_key = credentials.server.secret_key;
     broker_options.auth.allowed_keys = credentials.allowed_keys;
@@ -175,13 +181,13 @@ int main(int argc, char** argv) {
     sky.envmap_cache_bytes = static_cast<std::size_t>(options.envmap_cache_mb) << 20;
     http_options.sky = std::make_shared<SkyService>(sky);
     http_options.timelapses = &timelapses;
-    AssetStoreOptions asset_options;
-    asset_options.import.command = {"/proc/self/exe", "import-mesh"};
-    AssetStore assets(options.data_dir, asset_options);
     http_options.assets = &assets;
     http_options.extra_metrics = [&broker] {
       const BrokerStats s = broker.stats();
-      return nlohmann::json{{"auth_failures", s.auth_failures}, {"results_refused", s.results_refused}};
+      return nlohmann::json{{"auth_failures", s.auth_failures},
+                            {"results_refused", s.results_refused},
+                            {"assets_served", s.assets_served},
+                            {"assets_refused", s.assets_refused}};
     };
     HttpApi api(service, http_options);
     // Slow clients wait for their whole request in the gate, not on a thread (http_gate.h).
@@ -207,6 +213,8 @@ int main(int argc, char** argv) {
     local.count = options.local_workers < 0 ? skyfarm::resolve_thread_count(0) : options.local_workers;
     local.worker_secret = credentials.local_secret;
     local.server_key = credentials.server.public_key;
+    // Beside the store they fetch from: one copy per machine, gone with the data.
+    local.asset_cache = (std::filesystem::path(options.data_dir) / "worker-assets").string();
     LocalWorkers workers(local);
     workers.start();
 

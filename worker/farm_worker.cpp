@@ -26,6 +26,9 @@
 #include "common/film/film_tile.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
+#include "worker/asset_cache.h"
+#include "worker/asset_requests.h"
+#include "worker/mesh_cache.h"
 #include "worker/probe_unit.h"
 #include "worker/setup_cache.h"
 
@@ -45,15 +48,17 @@ struct JobRenderer {
   std::unique_ptr<TileRenderer> renderer;
 };
 
-JobRenderer make_job_renderer(const std::string& request_text) {
+JobRenderer make_job_renderer(const std::string& request_text, const assets::MeshSource* meshes) {
   try {
     const api::RenderRequest request = api::parse_render_request(request_text);
     JobRenderer job;
-    job.setup = make_render_setup(api::render_spec(request));
+    job.setup = make_render_setup(api::render_spec(request), meshes);
     job.renderer = std::make_unique<TileRenderer>(*job.setup.scene, *job.setup.camera, job.setup.plan);
     return job;
   } catch (const api::ValidationError& ex) {
     throw std::runtime_error(std::string("invalid request: ") + ex.what());
+  } catch (const AssetUnavailable& ex) {
+    throw TransientSetupError(std::string("cannot set up the render: ") + ex.what());
   } catch (const std::exception& ex) {
     throw std::runtime_error(std::string("cannot set up the render: ") + ex.what());
   }
@@ -61,7 +66,9 @@ JobRenderer make_job_renderer(const std::string& request_text) {
 
 // The setups of render jobs and of probes, each an LRU of setup_cache_jobs.
 struct Setups {
-  explicit Setups(std::size_t jobs) : renders(jobs, make_job_renderer), probes(jobs, make_probe_setup) {}
+  Setups(std::size_t jobs, const assets::MeshSource* meshes)
+      : renders(jobs, [meshes](const std::string& request) { return make_job_renderer(request, meshes); }),
+        probes(jobs, make_probe_setup) {}
   SetupCache<JobRenderer> renders;
   SetupCache<ProbeSetup> probes;
 };
@@ -118,8 +125,8 @@ api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
 // for the I/O thread, which is woken through the pipe.
 class RenderPool {
  public:
-  RenderPool(int threads, std::size_t cache_jobs, const WakeupPipe& wakeup)
-      : setups_(cache_jobs), wakeup_(wakeup) {
+  RenderPool(int threads, std::size_t cache_jobs, const assets::MeshSource* meshes, const WakeupPipe& wakeup)
+      : setups_(cache_jobs, meshes), wakeup_(wakeup) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
   }
   ~RenderPool() { stop(); }
@@ -214,11 +221,16 @@ struct FarmWorker::Impl {
   std::atomic<bool> drain{false};
   std::atomic<bool> paused{false};
   std::atomic<bool> running{false};
+  std::atomic<bool> stopping{false};  // run() is returning: no more asset questions
   WakeupPipe wakeup;
   struct Counters {
     std::atomic<std::uint64_t> sessions{0}, units_received{0}, results_sent{0}, failures_sent{0},
-        cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0}, auth_failures{0};
+        cancels_received{0}, results_dropped{0}, malformed{0}, send_failures{0}, auth_failures{0},
+        assets_requested{0}, assets_received{0};
   } counters;
+  AssetRequests asset_requests{[this] { wakeup.notify(); }};
+  std::unique_ptr<AssetDiskCache> asset_disk;
+  std::unique_ptr<MeshCache> meshes;
 
  private:
   // --- sessions
@@ -230,6 +242,8 @@ struct FarmWorker::Impl {
   // --- units
   void accept_unit(const api::UnitMsg& unit);
   void forward_outcomes(zmq::socket_t& socket);
+  void ask_for_assets(zmq::socket_t& socket);
+  std::string fetch_asset(const std::string& id);
   // --- plumbing
   bool send(zmq::socket_t& socket, const api::Message& message);
   std::optional<api::Message> receive(zmq::socket_t& socket);
@@ -258,11 +272,17 @@ FarmWorker::Impl::Impl(FarmWorkerOptions o) : options(std::move(o)) {
   options.heartbeat_liveness = std::max(1, options.heartbeat_liveness);
   if (options.reconnect_initial <= Ms(0)) options.reconnect_initial = Ms(1000);
   options.reconnect_max = std::max(options.reconnect_max, options.reconnect_initial);
+  if (options.asset_timeout <= Ms(0)) options.asset_timeout = Ms(60000);
+  if (!options.asset_cache_dir.empty())
+    asset_disk = std::make_unique<AssetDiskCache>(options.asset_cache_dir, options.asset_cache_bytes);
+  meshes = std::make_unique<MeshCache>(
+      asset_disk.get(), [this](const std::string& id) { return fetch_asset(id); }, options.asset_memory_bytes);
 }
 
 int FarmWorker::Impl::run() {
   if (running.exchange(true)) throw std::logic_error("FarmWorker::run called twice");
-  pool_ = std::make_unique<RenderPool>(threads, static_cast<std::size_t>(options.setup_cache_jobs), wakeup);
+  pool_ = std::make_unique<RenderPool>(threads, static_cast<std::size_t>(options.setup_cache_jobs), meshes.get(),
+                                       wakeup);
   log("worker " + options.id + ": " + std::to_string(threads) + " render threads, " + std::to_string(slots) +
       " slots, server " + options.endpoint);
   zmq::context_t ctx(1);
@@ -272,7 +292,9 @@ int FarmWorker::Impl::run() {
     if (drain_requested()) break;  // not connected: nothing to hand back
     zmq::socket_t socket(ctx, zmq::socket_type::dealer);
     socket.set(zmq::sockopt::linger, 0);
-    socket.set(zmq::sockopt::maxmsgsize, static_cast<std::int64_t>(64) << 20);
+    // The largest frame the server sends is an ASSET's mesh file.
+    socket.set(zmq::sockopt::maxmsgsize,
+               static_cast<std::int64_t>(std::max<std::size_t>(api::kMaxAssetBytes, std::size_t{64} << 20)));
     std::optional<zmq::socket_t> monitor;
     if (!options.server_key.empty()) {
       socket.set(zmq::sockopt::curve_serverkey, options.server_key);
@@ -297,6 +319,8 @@ int FarmWorker::Impl::run() {
     if (!wait_backoff(backoff)) break;
     backoff = std::min(backoff * 2, options.reconnect_max);
   }
+  stopping.store(true);
+  asset_requests.close("the worker is stopping");  // render threads waiting for one finish now
   pool_->stop();
   return rc;  // ctx terminates here: queued results and DISCONNECT get drain_linger to leave
 }
@@ -326,6 +350,7 @@ SessionEnd FarmWorker::Impl::serve(zmq::socket_t& socket) {
   draining_ = false;
   server_span_ = options.heartbeat_interval * options.heartbeat_liveness;
   send_ready(socket);
+  asset_requests.resend_all();  // questions sent on an earlier socket are lost with it
   for (;;) {
     if (paused.load()) {
       std::this_thread::sleep_for(Ms(10));
@@ -354,6 +379,7 @@ SessionEnd FarmWorker::Impl::serve(zmq::socket_t& socket) {
       log("worker " + options.id + ": draining (" + std::to_string(units_.size()) + " units to finish)");
       send(socket, heartbeat());
     }
+    ask_for_assets(socket);
     forward_outcomes(socket);
     if (draining_ && units_.empty()) {
       send(socket, api::DisconnectMsg{"worker draining", false});
@@ -381,10 +407,13 @@ std::optional<SessionEnd> FarmWorker::Impl::handle(zmq::socket_t& socket, const 
   } else if (const auto* bye = std::get_if<api::DisconnectMsg>(&message)) {
     log("worker " + options.id + ": server disconnected" + (bye->reason.empty() ? "" : ": " + bye->reason));
     return bye->fatal ? SessionEnd::kRefused : SessionEnd::kServerGone;
+  } else if (const auto* asset = std::get_if<api::AssetMsg>(&message)) {
+    if (asset_requests.answer(*asset) && asset->ok) ++counters.assets_received;
   } else if (std::holds_alternative<api::ReregisterMsg>(message)) {
     abandon_units();
     if (draining_) return SessionEnd::kDrained;  // the server holds nothing of ours
     send_ready(socket);
+    asset_requests.resend_all();  // an unregistered worker's questions were not answered
   } else {
     ++counters.malformed;  // READY, RESULT, FAILED: not for a worker
   }
@@ -467,6 +496,30 @@ void FarmWorker::Impl::forward_outcomes(zmq::socket_t& socket) {
   }
 }
 
+// --- Assets ------------------------------------------------------------------------------
+
+void FarmWorker::Impl::ask_for_assets(zmq::socket_t& socket) {
+  for (const std::string& id : asset_requests.take_unsent()) {
+    if (send(socket, api::AssetGetMsg{id})) {
+      ++counters.assets_requested;
+      log("worker " + options.id + ": fetching asset " + id);
+    } else {
+      asset_requests.unsent(id);
+    }
+  }
+}
+
+// On a render thread (MeshCache): once more when no answer came.
+std::string FarmWorker::Impl::fetch_asset(const std::string& id) {
+  try {
+    return asset_requests.fetch(id, options.asset_timeout);
+  } catch (const AssetUnavailable& e) {
+    if (stopping.load()) throw;
+    log("worker " + options.id + ": " + e.what() + "; asking again");
+    return asset_requests.fetch(id, options.asset_timeout);
+  }
+}
+
 // --- Plumbing ------------------------------------------------------------------------------
 
 bool FarmWorker::Impl::send(zmq::socket_t& socket, const api::Message& message) {
@@ -538,7 +591,8 @@ FarmWorkerStats FarmWorker::stats() const {
   const auto& c = impl_->counters;
   return FarmWorkerStats{c.sessions.load(),         c.units_received.load(),  c.results_sent.load(),
                          c.failures_sent.load(),    c.cancels_received.load(), c.results_dropped.load(),
-                         c.malformed.load(),        c.send_failures.load(),     c.auth_failures.load()};
+                         c.malformed.load(),        c.send_failures.load(),     c.auth_failures.load(),
+                         c.assets_requested.load(), c.assets_received.load()};
 }
 
 void FarmWorker::set_paused_for_testing(bool paused) {

@@ -29,6 +29,13 @@
 // Probe units (UNIT kind "probe", worker/probe_unit.h) run on the same
 //   render threads and slots as render units; READY advertises them with
 //   the capability "probe": api::kProbeUnitsVersion.
+// Mesh assets: a job whose objects name mesh assets gets them from a
+//   MeshCache (worker/mesh_cache.h) shared by all jobs: memory, then the disk
+//   cache asset_cache_dir, then the server (ASSET_GET, api/wire.h), asked
+//   through the I/O thread (worker/asset_requests.h) and waited for up to
+//   asset_timeout, twice.  A unit whose asset cannot be had FAILs with a
+//   message naming the asset; one that got no answer in time is set up again
+//   by the job's next unit, other errors are the job's on this worker.
 // CANCEL: a queued unit is dropped; one being rendered finishes but its
 //   result is not sent.
 // Server lost (nothing heard for heartbeat_liveness x interval, or a
@@ -50,6 +57,7 @@
 #pragma once
 #include <atomic>
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -76,6 +84,12 @@ struct FarmWorkerOptions {
   std::chrono::milliseconds reconnect_max{32000};
   std::chrono::milliseconds drain_linger{2000};
   int setup_cache_jobs = 4;
+  // Mesh assets (see above): the disk cache (empty: none) and its bound, the
+  // bound on decoded meshes in memory, the wait for the server's answer.
+  std::string asset_cache_dir;
+  std::size_t asset_cache_bytes = std::size_t{2048} << 20;
+  std::size_t asset_memory_bytes = std::size_t{1} << 30;
+  std::chrono::milliseconds asset_timeout{60000};
   // Checked every loop tick (<= 100 ms) in addition to request_drain(); a
   // signal handler may set it (async-signal-safe).
   const std::atomic<bool>* drain_flag = nullptr;
@@ -94,6 +108,8 @@ struct FarmWorkerStats {
   std::uint64_t malformed = 0;        // undecodable or unexpected messages from the server
   std::uint64_t send_failures = 0;    // messages the socket would not queue
   std::uint64_t auth_failures = 0;    // CURVE handshakes the server refused or that failed
+  std::uint64_t assets_requested = 0; // ASSET_GET sent
+  std::uint64_t assets_received = 0;  // ASSET answers with the file
 };
 
 class FarmWorker {
@@ -124,10 +140,11 @@ class FarmWorker {
 std::string default_worker_id();
 
 // `skyfarm-worker [--connect URL] [--threads N] [--slots N] [--token SECRET]
-// [--id NAME] [--secret-file PATH] [--key-file PATH] [--server-key KEY|PATH]`,
-// each flag also read from SKYFARM_CONNECT, SKYFARM_THREADS, SKYFARM_SLOTS,
-// SKYFARM_TOKEN, SKYFARM_ID, SKYFARM_WORKER_SECRET_FILE, SKYFARM_KEY_FILE,
-// SKYFARM_SERVER_KEY (a flag wins over its variable); SKYFARM_WORKER_SECRET
+// [--id NAME] [--secret-file PATH] [--key-file PATH] [--server-key KEY|PATH]
+// [--asset-cache DIR] [--asset-cache-mb N]`, each flag also read from
+// SKYFARM_CONNECT, SKYFARM_THREADS, SKYFARM_SLOTS, SKYFARM_TOKEN, SKYFARM_ID,
+// SKYFARM_WORKER_SECRET_FILE, SKYFARM_KEY_FILE, SKYFARM_SERVER_KEY,
+// SKYFARM_ASSET_CACHE, SKYFARM_ASSET_CACHE_MB (a flag wins over its variable); SKYFARM_WORKER_SECRET
 // holds the secret itself (it wins over a secret file).  Credentials
 // (kFarmWorkerUsage): a key file wins for our own key pair, else the secret's
 // derived pair; the server key is --server-key, else derived from the secret.

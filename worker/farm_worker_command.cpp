@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "api/curve_keys.h"
+#include "worker/asset_cache.h"
 #include "worker/farm_worker.h"
 #include "worker/signals.h"
 
@@ -14,6 +15,7 @@ namespace skyfarm {
 const char* const kFarmWorkerUsage =
     "  [--connect URL] [--threads N] [--slots N] [--id NAME]\n"
     "  [--secret-file PATH] [--key-file PATH] [--server-key KEY|PATH] [--token SECRET]\n"
+    "  [--asset-cache DIR] [--asset-cache-mb N]\n"
     "                                (default) a farm worker: connect to the server's broker\n"
     "                                (URL tcp://127.0.0.1:5555), render the units it hands out\n"
     "                                on N threads (0 = all cores) holding N+1 units (--slots);\n"
@@ -27,9 +29,14 @@ const char* const kFarmWorkerUsage =
     "                                one is given).  With none on a loopback URL it uses\n"
     "                                ./skyfarm-data/keys/worker.secret if readable.  --token is\n"
     "                                still accepted and sent, but is no longer a credential.\n"
+    "                                Mesh assets the units name are fetched from the server once\n"
+    "                                and kept in --asset-cache DIR (default $CACHE_DIRECTORY/assets,\n"
+    "                                else ~/.cache/skyfarm/assets, else /tmp/skyfarm-worker-UID/assets),\n"
+    "                                at most --asset-cache-mb N (2048) MB, least recently used first out.\n"
     "                                Each flag also reads SKYFARM_CONNECT, SKYFARM_THREADS,\n"
     "                                SKYFARM_SLOTS, SKYFARM_ID, SKYFARM_WORKER_SECRET_FILE,\n"
-    "                                SKYFARM_KEY_FILE, SKYFARM_SERVER_KEY, SKYFARM_TOKEN\n";
+    "                                SKYFARM_KEY_FILE, SKYFARM_SERVER_KEY, SKYFARM_TOKEN,\n"
+    "                                SKYFARM_ASSET_CACHE, SKYFARM_ASSET_CACHE_MB\n";
 
 namespace {
 
@@ -72,6 +79,24 @@ std::string apply(const std::string& flag, const std::string& value, FarmWorkerO
     return "";
   }
   if (flag == "--threads") return read_count(flag, value, &o->threads);
+  if (flag == "--asset-cache") {
+    if (value.empty()) return flag + ": a directory is required";
+    o->asset_cache_dir = value;
+    return "";
+  }
+  if (flag == "--asset-cache-mb") {
+    std::size_t used = 0;
+    long long mb = -1;
+    try {
+      mb = std::stoll(value, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != value.size() || mb < 1 || mb > (1ll << 30))
+      return flag + ": expected a number of megabytes >= 1, got '" + value + "'";
+    o->asset_cache_bytes = static_cast<std::size_t>(mb) << 20;
+    return "";
+  }
   if (flag == "--slots") return read_count(flag, value, &o->slots);
   if (flag == "--token") {
     o->token = value;
@@ -92,7 +117,9 @@ std::string parse(const std::vector<std::string>& args, FarmWorkerOptions* o, Cr
                                                           {"--id", "SKYFARM_ID"},
                                                           {"--secret-file", "SKYFARM_WORKER_SECRET_FILE"},
                                                           {"--key-file", "SKYFARM_KEY_FILE"},
-                                                          {"--server-key", "SKYFARM_SERVER_KEY"}};
+                                                          {"--server-key", "SKYFARM_SERVER_KEY"},
+                                                          {"--asset-cache", "SKYFARM_ASSET_CACHE"},
+                                                          {"--asset-cache-mb", "SKYFARM_ASSET_CACHE_MB"}};
   for (const auto& [flag, name] : from_env)
     if (const auto v = env(name))
       if (std::string err = apply(flag, *v, o, c); !err.empty()) return std::string(name) + " (" + err + ")";
@@ -159,6 +186,7 @@ int run_farm_worker_command(const std::vector<std::string>& args) {
   Credentials keys;
   std::string err = parse(args, &options, &keys);
   if (err.empty()) err = credentials(keys, &options);
+  if (options.asset_cache_dir.empty()) options.asset_cache_dir = default_asset_cache_dir();
   if (!err.empty()) {
     std::cerr << "skyfarm-worker: " << err
               << "\nusage: skyfarm-worker [--connect URL] [--threads N] [--slots N] [--id NAME] [--secret-file PATH]"

@@ -6,6 +6,9 @@
 #include <filesystem>
 #include <iostream>
 #include <algorithm>
+#include <cstdlib>
+#include <limits>
+#include <memory>
 #include <optional>
 
 #include "api/field_error.h"
@@ -22,12 +25,13 @@
 #include "common/render/radiance_probe.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
+#include "worker/request_assets.h"
 
 namespace skyfarm {
 namespace {
 
 struct RenderArgs {
-  std::string request, exr, png;
+  std::string request, exr, png, asset_cache;
   int threads = 0;
   int png_bits = 8;
 };
@@ -41,6 +45,8 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
       out->exr = args[++i];
     } else if (a == "--png" && has_value) {
       out->png = args[++i];
+    } else if (a == "--asset-cache" && has_value) {
+      out->asset_cache = args[++i];
     } else if (a == "--png-16bit") {
       out->png_bits = 16;
     } else if (a == "--threads" && has_value) {
@@ -67,9 +73,10 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
 }  // namespace
 
 int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
-                    int threads, const std::string& label, int png_bits = 8) {
+                    int threads, const std::string& label, int png_bits = 8,
+                    const assets::MeshSource* meshes = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
-  const RenderSetup setup = make_render_setup(api::render_spec(request));
+  const RenderSetup setup = make_render_setup(api::render_spec(request), meshes);
   const Scene& scene = *setup.scene;
   const RenderPlan& plan = setup.plan;
   const TileRenderer renderer(scene, *setup.camera, plan);
@@ -139,7 +146,8 @@ int run_render_command(const std::vector<std::string>& args) {
   RenderArgs a;
   if (const std::string err = parse_render_args(args, &a); !err.empty()) {
     std::cerr << "skyfarm-worker render: " << err
-              << "\nusage: skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png [--png-16bit]] [--threads N]\n";
+              << "\nusage: skyfarm-worker render REQUEST.json -o OUT.exr [--png OUT.png [--png-16bit]] [--threads N]"
+                 "\n       [--asset-cache DIR]\n";
     return 2;
   }
   std::string text, error;
@@ -148,8 +156,24 @@ int run_render_command(const std::vector<std::string>& args) {
     return 1;
   }
   try {
+    // Mesh files named by path become asset ids before the request is parsed (request_assets.h).
+    std::unique_ptr<AssetDiskCache> disk;  // read only: the farm worker's cache
+    std::unique_ptr<LocalMeshSource> meshes;
+    nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+    if (json.is_object() && json.contains("objects")) {
+      const char* env_cache = std::getenv("SKYFARM_ASSET_CACHE");
+      disk = std::make_unique<AssetDiskCache>(!a.asset_cache.empty() ? a.asset_cache
+                                              : env_cache != nullptr && *env_cache != '\0'
+                                                  ? std::string(env_cache)
+                                                  : default_asset_cache_dir(),
+                                              std::numeric_limits<std::size_t>::max());
+      const std::filesystem::path base =
+          a.request == "-" ? std::filesystem::current_path() : std::filesystem::path(a.request).parent_path();
+      meshes = resolve_request_assets(&json, base.string(), disk.get());
+      text = json.dump();
+    }
     const api::RenderRequest request = api::parse_render_request(text);
-    return render_to_files(request, a.exr, a.png, a.threads, "render", a.png_bits);
+    return render_to_files(request, a.exr, a.png, a.threads, "render", a.png_bits, meshes.get());
   } catch (const api::ValidationError& e) {
     std::cerr << a.request << ": invalid request\n" << e.what() << "\n";
     return 2;

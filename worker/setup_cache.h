@@ -4,7 +4,9 @@
 // under its own mutex, so threads working on other jobs do not wait; an
 // entry is rebuilt when the job's request text differs from the cached one;
 // a request that cannot be set up caches its error, which every unit of the
-// job then reports.  Entries evicted while in use live on in their users.
+// job then reports, unless the error is a TransientSetupError (an asset the
+// server did not send in time): the next unit builds again.  Entries evicted
+// while in use live on in their users.
 #pragma once
 #include <algorithm>
 #include <functional>
@@ -17,6 +19,12 @@
 #include <utility>
 
 namespace skyfarm {
+
+// A setup that failed for now (the next attempt may work): not cached.
+class TransientSetupError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 template <class Setup>
 class SetupCache {
@@ -36,6 +44,9 @@ class SetupCache {
       e->built = true;
       try {
         e->setup.emplace(build_(e->request));
+      } catch (const TransientSetupError&) {
+        e->built = false;
+        throw;
       } catch (const std::exception& ex) {
         e->error = ex.what();
       }

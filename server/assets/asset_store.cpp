@@ -1,6 +1,5 @@
 #include "server/assets/asset_store.h"
 
-#include <sodium.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -10,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "common/assets/asset_id.h"
 #include "common/assets/mesh_file.h"
 #include "common/assets/triangle_mesh.h"
 
@@ -18,8 +18,6 @@ namespace skyfarm::server {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr std::string_view kIdPrefix = "sha256:";
 
 void write_atomically(const fs::path& path, std::string_view bytes) {
   static std::atomic<unsigned> counter{0};
@@ -37,25 +35,6 @@ void write_atomically(const fs::path& path, std::string_view bytes) {
 }
 
 }  // namespace
-
-bool is_asset_id(std::string_view id) {
-  if (id.size() != kIdPrefix.size() + 64 || id.substr(0, kIdPrefix.size()) != kIdPrefix) return false;
-  for (char c : id.substr(kIdPrefix.size()))
-    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return false;
-  return true;
-}
-
-std::string sha256_hex(std::string_view bytes) {
-  unsigned char digest[crypto_hash_sha256_BYTES];
-  crypto_hash_sha256(digest, reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size());
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string hex;
-  for (unsigned char b : digest) {
-    hex += kHex[b >> 4];
-    hex += kHex[b & 15];
-  }
-  return hex;
-}
 
 AssetStore::AssetStore(const std::string& data_dir, AssetStoreOptions options)
     : dir_((fs::path(data_dir) / "assets").string()), options_(std::move(options)) {
@@ -89,7 +68,7 @@ AssetPut AssetStore::put(std::string_view bytes, std::string_view format) {
   const std::string file = assets::encode_mesh_file(imported.mesh);
   const std::string hex = sha256_hex(file);
   const assets::MeshBounds b = assets::mesh_bounds(imported.mesh);
-  put.meta = {{"id", std::string(kIdPrefix) + hex},
+  put.meta = {{"id", std::string(assets::kAssetIdPrefix) + hex},
               {"triangles", imported.mesh.triangle_count()},
               {"vertices", imported.mesh.vertex_count()},
               {"bounds", {{"min", b.min}, {"max", b.max}}},
@@ -106,7 +85,7 @@ AssetPut AssetStore::put(std::string_view bytes, std::string_view format) {
 
 std::optional<nlohmann::json> AssetStore::meta(std::string_view id) const {
   if (!is_asset_id(id)) return std::nullopt;
-  const fs::path path = fs::path(dir_) / (std::string(id.substr(kIdPrefix.size())) + ".json");
+  const fs::path path = fs::path(dir_) / (std::string(assets::asset_hex(id)) + ".json");
   std::ifstream in(path);
   if (!in) return std::nullopt;
   try {
@@ -118,7 +97,17 @@ std::optional<nlohmann::json> AssetStore::meta(std::string_view id) const {
 
 std::optional<std::string> AssetStore::mesh_path(std::string_view id) const {
   if (!meta(id)) return std::nullopt;
-  return (fs::path(dir_) / (std::string(id.substr(kIdPrefix.size())) + ".mesh")).string();
+  return (fs::path(dir_) / (std::string(assets::asset_hex(id)) + ".mesh")).string();
+}
+
+std::optional<std::string> AssetStore::mesh_file(std::string_view id) const {
+  const std::optional<std::string> path = mesh_path(id);
+  if (!path) return std::nullopt;
+  std::ifstream in(*path, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw std::runtime_error("cannot read " + *path);
+  return bytes;
 }
 
 }  // namespace skyfarm::server

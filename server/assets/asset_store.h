@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/assets/asset_id.h"
 #include "server/assets/mesh_import_process.h"
 
 namespace skyfarm::server {
@@ -55,6 +56,9 @@ class AssetStore {
   std::optional<nlohmann::json> meta(std::string_view id) const;
   // The path of its .mesh file, or nullopt.
   std::optional<std::string> mesh_path(std::string_view id) const;
+  // The bytes of its .mesh file (what a worker fetches), or nullopt.  Throws
+  // std::runtime_error when the file exists but cannot be read.
+  std::optional<std::string> mesh_file(std::string_view id) const;
 
   const AssetStoreOptions& options() const { return options_; }
 
@@ -66,10 +70,8 @@ class AssetStore {
   int importing_ = 0;
 };
 
-// "sha256:" and 64 lowercase hex digits.
-bool is_asset_id(std::string_view id);
-
-// Lowercase hex SHA-256 of `bytes`.
-std::string sha256_hex(std::string_view bytes);
+// The ids' rules live with the renderer (common/assets/asset_id.h): workers check them too.
+using assets::is_asset_id;
+using assets::sha256_hex;
 
 }  // namespace skyfarm::server

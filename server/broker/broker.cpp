@@ -51,7 +51,7 @@ struct Broker::Shared {
   WakeupPipe wakeup;
   std::atomic<std::uint64_t> workers{0}, joined{0}, left{0}, lost{0}, rejected{0}, units_sent{0}, results{0},
       failures{0}, cancels_sent{0}, malformed{0}, unexpected{0}, reregisters_sent{0}, backend_errors{0},
-      auth_failures{0}, results_refused{0};
+      auth_failures{0}, results_refused{0}, assets_served{0}, assets_refused{0};
 };
 
 // Everything the broker thread owns.  Built (and bound) in start() on the
@@ -113,6 +113,7 @@ struct Broker::Loop {
   void handle_known(Worker& w, const api::Message& message);
   void handle_result(Worker& w, const api::ResultMsg& r);
   void handle_failed(Worker& w, const api::FailedMsg& f);
+  void handle_asset_get(Worker& w, const api::AssetGetMsg& get);
   bool fenced(Worker& w, const api::UnitRef& u, const char* what);
   // --- workers
   void refuse(const std::string& identity, const std::string& reason);
@@ -393,6 +394,8 @@ void Broker::Loop::handle_known(Worker& w, const api::Message& message) {
     handle_result(w, *r);
   } else if (const auto* f = std::get_if<api::FailedMsg>(&message)) {
     handle_failed(w, *f);
+  } else if (const auto* get = std::get_if<api::AssetGetMsg>(&message)) {
+    handle_asset_get(w, *get);
   } else if (std::holds_alternative<api::DisconnectMsg>(message)) {
     remove_worker(w.identity, "disconnected", false);
   } else {
@@ -440,6 +443,26 @@ void Broker::Loop::handle_failed(Worker& w, const api::FailedMsg& f) {
   log("broker: worker " + w.id + " failed unit " + f.unit.job + "/" + std::to_string(f.unit.tile) + "/" +
       std::to_string(f.unit.batch) + "/" + std::to_string(f.unit.pass) + ": " + f.message);
   guarded("unit_failed", [&] { backend_.unit_failed(w.id, key_of(f.unit), f.unit.attempt, f.message); });
+}
+
+void Broker::Loop::handle_asset_get(Worker& w, const api::AssetGetMsg& get) {
+  api::AssetMsg answer{get.id, false, "", ""};
+  std::optional<std::string> file;
+  if (options_.asset_file) guarded("asset_file", [&] { file = options_.asset_file(get.id); });
+  if (file && !file->empty()) {
+    answer.ok = true;
+    answer.file = std::move(*file);
+    ++shared_.assets_served;
+    log("broker: sent asset " + get.id + " (" + std::to_string(answer.file.size()) + " bytes) to worker " + w.id);
+  } else {
+    answer.error = options_.asset_file ? "no asset " + get.id + " on this server (upload it: POST /v1/assets)"
+                                       : "this server has no asset store (asset " + get.id + ")";
+    const auto n = ++shared_.assets_refused;
+    if (worth_logging(n))
+      log("broker: worker " + w.id + " asked for asset " + get.id + ", which is not here (" + std::to_string(n) +
+          " so far)");
+  }
+  send_or_lose(w.identity, answer);
 }
 
 // --- Loop: workers ------------------------------------------------------------------
@@ -620,7 +643,8 @@ BrokerStats Broker::stats() const {
   return BrokerStats{s.workers.load(),    s.joined.load(),       s.left.load(),         s.lost.load(),
                      s.rejected.load(),   s.units_sent.load(),   s.results.load(),      s.failures.load(),
                      s.cancels_sent.load(), s.malformed.load(),  s.unexpected.load(),   s.reregisters_sent.load(),
-                     s.backend_errors.load(), s.auth_failures.load(), s.results_refused.load()};
+                     s.backend_errors.load(), s.auth_failures.load(), s.results_refused.load(),
+                     s.assets_served.load(),  s.assets_refused.load()};
 }
 
 }  // namespace skyfarm::server

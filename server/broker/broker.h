@@ -54,6 +54,13 @@
 //   cancels     backend.take_cancelled_attempts() each tick -> CANCEL to the
 //               holders still connected (their slot is freed at once).
 //   timeouts    backend.check_timeouts(now) every timeout_check_interval.
+//   assets      ASSET_GET from a registered worker is answered with ASSET:
+//               the mesh file `asset_file` returns (ok), or ok=false and a
+//               sentence when it returns nothing (not in the store, or no
+//               store).  The file is read on the broker thread: tens of ms
+//               for tens of MB, a pause the heartbeats' liveness (seconds)
+//               absorbs, once per worker and asset (workers cache them).
+//               A send that fails loses the worker, as for a UNIT.
 // Malformed or unexpected messages are counted (stats) and dropped; an
 // exception from the backend is logged and counted, never kills the thread.
 //
@@ -67,6 +74,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -94,6 +102,10 @@ struct BrokerOptions {
   std::chrono::milliseconds pipeline_target{100};
   std::chrono::milliseconds shutdown_linger{200};
   std::size_t max_message_bytes = 64u << 20;  // ZMQ_MAXMSGSIZE: larger messages drop the peer's connection
+  // The bytes of a mesh asset's file (common/assets/mesh_file.h) by id, or
+  // nullopt when there is no such asset; may throw (counted as a backend
+  // error, answered ok=false).  Empty: every ASSET_GET is refused.
+  std::function<std::optional<std::string>(const std::string& id)> asset_file;
   // Log lines ("worker w1 joined (4 slots)"); empty: standard error.
   std::function<void(std::string_view)> log;
 };
@@ -115,6 +127,8 @@ struct BrokerStats {
   std::uint64_t backend_errors = 0;    // exceptions thrown by the backend
   std::uint64_t auth_failures = 0;     // CURVE handshakes denied or failed (incl. rate-limited)
   std::uint64_t results_refused = 0;   // RESULT / FAILED for an attempt the worker was not sent
+  std::uint64_t assets_served = 0;     // ASSET answers with the file
+  std::uint64_t assets_refused = 0;    // ASSET answers without (unknown id, no store, read error)
 };
 
 class Broker {

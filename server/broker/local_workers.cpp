@@ -27,6 +27,7 @@ pid_t LocalWorkers::spawn(int index) {
                          (restarts > 0 ? "-r" + std::to_string(restarts) : "");
   std::vector<std::string> args = {options_.worker_binary, "--connect", options_.endpoint, "--threads", threads,
                                    "--id", id};
+  if (!options_.asset_cache.empty()) args.insert(args.end(), {"--asset-cache", options_.asset_cache});
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);

@@ -26,6 +26,7 @@ struct LocalWorkerOptions {
   int threads_each = 1;
   std::string worker_secret;  // SKYFARM_WORKER_SECRET of every worker
   std::string server_key;     // SKYFARM_SERVER_KEY (Z85 public key); empty: derived from the secret
+  std::string asset_cache;    // --asset-cache of every worker (they share it); empty: the worker's default
 };
 
 class LocalWorkers {

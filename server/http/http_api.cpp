@@ -9,6 +9,7 @@
 
 #include "api/json_fields.h"
 #include "api/render_request.h"
+#include "api/render_spec.h"
 #include "server/http/http_checks.h"
 #include "server/http/http_files.h"
 #include "server/http/http_gate.h"
@@ -20,6 +21,7 @@
 #include "server/sky/http_sky.h"
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
+#include "server/assets/asset_admission.h"
 #include "server/assets/asset_http.h"
 #include "api/probe_answer.h"
 #include "api/probe_spec.h"
@@ -338,7 +340,8 @@ void HttpApi::add_routes(httplib::Server& server) {
                          "", "JSON nested deeper than " + std::to_string(options_.max_json_depth) + " levels", ""}});
                    return body;
                  },
-                 [](const Request& req) { return idempotency_key_of(req); }});
+                 [](const Request& req) { return idempotency_key_of(req); },
+                 [this](const api::RenderRequest& request) { admit_objects(request); }});
   if (assets_)
     assets_->add_routes(routes, {[](const Request& req, Response& res, const std::function<void()>& handler) {
                                    run_guarded(req, res, handler);
@@ -374,6 +377,7 @@ void HttpApi::submit(const Request& req, Response& res, const ContentReader& rea
     throw api::ValidationError(
         {api::FieldError{"", "JSON nested deeper than " + std::to_string(options_.max_json_depth) + " levels", ""}});
   const api::RenderRequest request = api::parse_render_request(std::string_view(body));
+  admit_objects(request);
   const SubmitResult result = backend_.submit(request, key);
   const nlohmann::json answer = {{"id", result.id},
                                  {"state", state_of(backend_.status(result.id))},
@@ -382,6 +386,13 @@ void HttpApi::submit(const Request& req, Response& res, const ContentReader& rea
                                  {"links", render_links(result.id)}};
   res.set_header("Location", render_path(result.id));
   send_json(res, 202, answer);
+}
+
+// The mesh assets a request's objects name must be in the store before a job
+// is made, or every worker would fail its units (400 naming objects[i].asset).
+void HttpApi::admit_objects(const api::RenderRequest& request) const {
+  std::vector<api::FieldError> errors = missing_assets(api::render_spec(request).objects, options_.assets);
+  if (!errors.empty()) throw api::ValidationError(std::move(errors));
 }
 
 void HttpApi::list(const Request& req, Response& res) {

@@ -140,6 +140,7 @@ class HttpApi {
 
   // Route handlers.
   void submit(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
+  void admit_objects(const api::RenderRequest& request) const;
   void list(const httplib::Request& req, httplib::Response& res);
   void status(const httplib::Request& req, httplib::Response& res);
   void cancel(const httplib::Request& req, httplib::Response& res);

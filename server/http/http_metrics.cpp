@@ -30,6 +30,9 @@ constexpr KnownMetric kKnown[] = {
      "Worker CURVE handshakes denied or failed (unknown key, wrong mechanism, rate-limited address)."},
     {"results_refused", "skyfarm_results_refused_total", "counter",
      "Results refused: for an attempt not sent to that worker, or not exactly the unit's tile, batches and sample counts."},
+    {"assets_served", "skyfarm_assets_served_total", "counter", "Mesh assets sent to workers (ASSET_GET answered)."},
+    {"assets_refused", "skyfarm_assets_refused_total", "counter",
+     "Mesh assets workers asked for that the server does not have."},
     {"disk_used_bytes", "skyfarm_disk_used_bytes", "gauge", "Bytes the data directory holds (jobs' files, database)."},
     {"disk_budget_bytes", "skyfarm_disk_budget_bytes", "gauge", "The data directory's disk budget in bytes (0: none)."},
 };

@@ -77,6 +77,7 @@ void TimelapseHttp::submit(const Request& req, Response& res, const ContentReade
   const std::string body = hooks_.json_body(req, res, reader);
   const std::optional<std::string> key = hooks_.idempotency_key(req);
   const api::TimelapseRequest request = api::parse_timelapse_request(body, service_.options().max_frames);
+  if (hooks_.admit_objects) hooks_.admit_objects(request.base);
   const SubmitResult result = service_.submit(request, key);
   std::optional<nlohmann::json> doc = service_.status(result.id);
   if (!doc) throw http_error(500, "the timelapse vanished after its submission");

@@ -43,6 +43,9 @@ class TimelapseHttp {
     std::function<std::string(const httplib::Request&, httplib::Response&, const httplib::ContentReader&)> json_body;
     // The Idempotency-Key header, validated.
     std::function<std::optional<std::string>(const httplib::Request&)> idempotency_key;
+    // Throws api::ValidationError when the frames' objects name mesh assets
+    // the server lacks (as POST /v1/renders refuses them); empty: no check.
+    std::function<void(const api::RenderRequest&)> admit_objects;
   };
 
   // private_cache: final files are "private" (the API needs a token).

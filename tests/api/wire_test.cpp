@@ -39,6 +39,33 @@ TEST(WireTest, EveryMessageRoundTrips) {
   expect_round_trip(DisconnectMsg{});
   expect_round_trip(DisconnectMsg{"unauthorized", true});
   expect_round_trip(ReregisterMsg{});
+  const std::string id = "sha256:" + std::string(64, 'c');
+  expect_round_trip(AssetGetMsg{id});
+  expect_round_trip(AssetMsg{id, true, "", bytes});
+  expect_round_trip(AssetMsg{id, false, "no asset " + id + " on this server", ""});
+}
+
+// ASSET carries the mesh file as a binary payload frame when ok, and no
+// payload (but a reason) when not; ids are checked as the store names them.
+TEST(WireTest, AssetMessagesCarryTheFileOrAReason) {
+  const std::string id = "sha256:" + std::string(64, '0');
+  const std::string file("SKYMESH1\0\0\0\1", 12);
+  const Frames ok = encode(AssetMsg{id, true, "ignored when ok", file});
+  ASSERT_EQ(ok.size(), 3u);
+  EXPECT_EQ(ok[0], "ASSET");
+  EXPECT_EQ(ok[2], file);
+  EXPECT_EQ(ok[1].find("error"), std::string::npos) << ok[1];
+  EXPECT_EQ(std::get<AssetMsg>(decode(ok)).error, "");
+  const Frames refused = encode(AssetMsg{id, false, "", "ignored when not ok"});
+  ASSERT_EQ(refused.size(), 2u);
+  EXPECT_EQ(std::get<AssetMsg>(decode(refused)).error, "unknown error") << "a refusal always says something";
+  const Frames get = encode(AssetGetMsg{id});
+  ASSERT_EQ(get.size(), 2u);
+  EXPECT_EQ(get[0], "ASSET_GET");
+  EXPECT_EQ(command_from_name("ASSET_GET"), Command::kAssetGet);
+  EXPECT_EQ(command_from_name("ASSET"), Command::kAsset);
+  static_assert(kProtocolVersion == 4, "ASSET_GET / ASSET are version 4");
+  static_assert(kMaxAssetBytes == 168'000'016u, "the file of a mesh at the default MeshLimits");
 }
 
 // A probe unit says so ("kind": "probe"); a render unit's header is the
@@ -99,6 +126,7 @@ TEST(WireTest, FailedMessageIsCutToTheLimit) {
 
 TEST(WireTest, MalformedMessagesAreRejected) {
   const std::string unit = R"("job": "j", "tile": 0, "batch": 0, "pass": 0, "attempt": 1)";
+  const std::string asset = "sha256:" + std::string(64, 'a');
   const std::vector<Frames> bad = {
       {},
       {""},
@@ -144,6 +172,17 @@ TEST(WireTest, MalformedMessagesAreRejected) {
       {"CANCEL", R"({"attempt": 18446744073709551616})"},                           // 2^64
       {"DISCONNECT", R"({"fatal": 1})"},
       {"CANCEL", std::string(100000, '[') + std::string(100000, ']')},              // deep nesting
+      {"ASSET_GET", "{}"},
+      {"ASSET_GET", R"({"id": "cube.obj"})"},
+      {"ASSET_GET", R"({"id": "sha256:)" + std::string(64, 'A') + "\"}"},
+      {"ASSET_GET", R"({"id": ")" + asset + "\"}", "payload"},
+      {"ASSET", R"({"id": ")" + asset + "\"}", "file"},                                  // no ok
+      {"ASSET", R"({"id": ")" + asset + R"(", "ok": 1})", "file"},
+      {"ASSET", R"({"id": ")" + asset + R"(", "ok": true})"},                            // no payload
+      {"ASSET", R"({"id": ")" + asset + R"(", "ok": true})", ""},                        // empty payload
+      {"ASSET", R"({"id": ")" + asset + R"(", "ok": false, "error": "gone"})", "file"},  // payload on a refusal
+      {"ASSET", R"({"id": ")" + asset + R"(", "ok": false})"},                           // no reason
+      {"ASSET", R"({"id": "x", "ok": true})", "file"},
   };
   for (const Frames& f : bad) {
     std::string error;
@@ -155,7 +194,8 @@ TEST(WireTest, MalformedMessagesAreRejected) {
 
 TEST(WireTest, RandomBytesNeverCrashTheDecoder) {
   std::mt19937 rng(7);
-  const std::vector<std::string> commands = {"READY", "HEARTBEAT", "UNIT", "RESULT", "FAILED", "CANCEL", "DISCONNECT"};
+  const std::vector<std::string> commands = {"READY",  "HEARTBEAT",  "UNIT",      "RESULT", "FAILED",
+                                             "CANCEL", "DISCONNECT", "ASSET_GET", "ASSET"};
   for (int i = 0; i < 3000; ++i) {
     Frames f;
     f.push_back(i % 4 == 0 ? std::string(1 + rng() % 8, static_cast<char>(rng())) : commands[rng() % commands.size()]);

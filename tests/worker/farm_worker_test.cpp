@@ -18,6 +18,10 @@
 
 #include "api/probe_spec.h"
 #include "api/render_spec.h"
+#include "common/assets/asset_id.h"
+#include "common/assets/mesh_file.h"
+#include "common/assets/mesh_source.h"
+#include "common/assets/triangle_mesh.h"
 #include "common/render/parallel.h"
 #include "common/render/tile_renderer.h"
 #include "server/broker/broker.h"
@@ -28,6 +32,7 @@ extern char** environ;
 namespace skyfarm {
 namespace {
 
+namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using skyfarm::testing::eventually;
 using skyfarm::testing::FakeBackend;
@@ -462,6 +467,103 @@ TEST_F(FarmWorkerTest, ProbeUnitsAreTracedAsTheLocalProbeDoes) {
       else
         EXPECT_NE(failed.message.find("method is lut"), std::string::npos) << failed.message;
     }
+  });
+}
+
+// --- Mesh assets -----------------------------------------------------------------------
+
+// A tetrahedron in front of an equirectangular camera, and its mesh file.
+const std::string& tetra_file() {
+  static const std::string file = [] {
+    assets::TriangleMesh m;
+    m.positions = {-1, 2, 0, 1, 2, 0, 0, 3, 0, 0, 2.5, 1.5};
+    m.indices = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    return assets::encode_mesh_file(assets::canonicalize_mesh(m));
+  }();
+  return file;
+}
+
+std::string mesh_request(const std::string& asset) {
+  const std::string body = R"({"sun": {"zenith_deg": 60, "azimuth_deg": 120},
+      "camera": {"projection": "equirectangular", "width": 64, "height": 8},
+      "spectral": {"batches": 2}, "quality": {"samples_per_pixel": 2},
+      "objects": [{"shape": "mesh", "asset": ")" + asset + R"(", "albedo": 0.5}]})";
+  return api::canonical_text(api::parse_render_request(body));
+}
+
+// Serves the tetrahedron, as the farm worker's cache would once fetched.
+struct OneMesh : assets::MeshSource {
+  std::shared_ptr<const assets::TriangleMesh> mesh(std::string_view) const override {
+    auto m = std::make_shared<assets::TriangleMesh>();
+    std::string error;
+    EXPECT_TRUE(assets::decode_mesh_file(tetra_file(), {}, m.get(), &error)) << error;
+    return m;
+  }
+};
+
+std::vector<std::uint8_t> local_mesh_unit_bytes(const std::string& request, int tile, int batch, int pass) {
+  const OneMesh meshes;
+  const RenderSetup setup = make_render_setup(api::render_spec(api::parse_render_request(request)), &meshes);
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  FilmTile film = renderer.empty_tile(tile);
+  PathCounters counters;
+  renderer.render_unit(WorkUnit{tile, batch, pass}, &film, &counters);
+  return film.serialize();
+}
+
+// Two render threads and two jobs naming the same asset: one ASSET_GET, the
+// bytes of a local render, the file kept in the disk cache for the next worker.
+TEST_F(FarmWorkerTest, AMeshAssetIsFetchedOnceAndRendersAsLocally) {
+  const std::string id = assets::asset_id_of(tetra_file());
+  std::atomic<int> reads{0};
+  server::BrokerOptions o = broker_options();
+  o.asset_file = [&](const std::string& asked) -> std::optional<std::string> {
+    ++reads;
+    if (asked == id) return tetra_file();
+    return std::nullopt;
+  };
+  start_broker(o);
+  const std::string request = mesh_request(id);
+  backend_.add_units("m1", 2, 2, 1, request);
+  backend_.add_units("m2", 2, 2, 1, request);
+  const fs::path cache = fs::temp_directory_path() / ("skyfarm_fw_assets_" + std::to_string(::getpid()));
+  fs::remove_all(cache);
+  FarmWorkerOptions wo = worker_options(broker_->bound_endpoint());
+  wo.threads = 2;
+  wo.asset_cache_dir = cache.string();
+  WorkerThread& w = start_worker(wo);
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() + f.failed.size() == 8; }, 20s));
+  backend_.with_lock([&](auto& f) {
+    for (const auto& failed : f.failed) ADD_FAILURE() << failed.key.job_id << ": " << failed.message;
+    for (const auto& d : f.done)
+      EXPECT_EQ(d.bytes, local_mesh_unit_bytes(request, d.key.tile, d.key.batch, d.key.pass))
+          << d.key.job_id << " tile " << d.key.tile << " batch " << d.key.batch;
+    return 0;
+  });
+  EXPECT_EQ(reads.load(), 1);
+  EXPECT_EQ(w.worker.stats().assets_requested, 1u);
+  EXPECT_EQ(w.worker.stats().assets_received, 1u);
+  EXPECT_TRUE(fs::exists(cache / (std::string(assets::asset_hex(id)) + ".mesh")));
+  EXPECT_EQ(w.finish(), 0);
+
+  // A second worker with the same cache never asks.
+  backend_.add_units("m3", 1, 1, 1, request);
+  WorkerThread& again = start_worker(wo);
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.done.size() == 9; }, 20s));
+  EXPECT_EQ(again.worker.stats().assets_requested, 0u);
+  EXPECT_EQ(reads.load(), 1);
+  fs::remove_all(cache);
+}
+
+TEST_F(FarmWorkerTest, AnAssetTheServerLacksFailsTheUnitNamingIt) {
+  start_broker();  // no asset store
+  const std::string id = "sha256:" + std::string(64, '4');
+  backend_.add_units("m", 1, 1, 1, mesh_request(id));
+  start_worker();
+  ASSERT_TRUE(backend_.wait_for([](auto& f) { return f.failed.size() == 1; }, 10s));
+  backend_.with_lock([&](auto& f) {
+    EXPECT_NE(f.failed[0].message.find(id), std::string::npos) << f.failed[0].message;
+    return 0;
   });
 }
 

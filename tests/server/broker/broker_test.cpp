@@ -8,6 +8,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <thread>
@@ -467,6 +468,55 @@ TEST_F(BrokerCurveTest, RepeatedFailuresLockTheAddressOutEvenForAValidKey) {
   EXPECT_FALSE(joins(api::derive_worker_keys(kSecret), "w1", 500ms));
   EXPECT_TRUE(eventually([&] { return broker_->stats().auth_failures > before; }));
   EXPECT_TRUE(backend_.with_lock([](auto& f) { return f.joined.empty(); }));
+}
+
+// ASSET_GET: the file asset_file returns, or a refusal naming the id; a
+// stranger is asked to register first and never gets a file.
+TEST_F(BrokerTest, AssetGetIsAnsweredFromTheStore) {
+  const std::string known = "sha256:" + std::string(64, 'a');
+  const std::string unknown = "sha256:" + std::string(64, 'b');
+  const std::string file("SKYMESH1\0payload", 16);
+  std::atomic<int> reads{0};
+  BrokerOptions o = test_options();
+  o.asset_file = [&](const std::string& id) -> std::optional<std::string> {
+    ++reads;
+    if (id == known) return file;
+    return std::nullopt;
+  };
+  start(o);
+  auto stranger = peer();
+  stranger->send(api::AssetGetMsg{known});
+  EXPECT_TRUE(stranger->receive_a<api::ReregisterMsg>());
+  EXPECT_EQ(reads.load(), 0) << "a peer that did not READY gets no asset";
+
+  auto p = joined_peer("w1");
+  p->send(api::AssetGetMsg{known});
+  auto got = p->receive_a<api::AssetMsg>();
+  ASSERT_TRUE(got);
+  EXPECT_TRUE(got->ok);
+  EXPECT_EQ(got->id, known);
+  EXPECT_EQ(got->file, file);
+  p->send(api::AssetGetMsg{unknown});
+  auto refused = p->receive_a<api::AssetMsg>();
+  ASSERT_TRUE(refused);
+  EXPECT_FALSE(refused->ok);
+  EXPECT_EQ(refused->id, unknown);
+  EXPECT_NE(refused->error.find(unknown), std::string::npos) << refused->error;
+  EXPECT_TRUE(refused->file.empty());
+  EXPECT_EQ(broker_->stats().assets_served, 1u);
+  EXPECT_EQ(broker_->stats().assets_refused, 1u);
+  EXPECT_EQ(broker_->stats().workers, 1u) << "asking for assets is no reason to drop a worker";
+}
+
+TEST_F(BrokerTest, WithoutAStoreEveryAssetGetIsRefused) {
+  start();
+  auto p = joined_peer("w1");
+  const std::string id = "sha256:" + std::string(64, 'c');
+  p->send(api::AssetGetMsg{id});
+  auto refused = p->receive_a<api::AssetMsg>();
+  ASSERT_TRUE(refused);
+  EXPECT_FALSE(refused->ok);
+  EXPECT_NE(refused->error.find(id), std::string::npos) << refused->error;
 }
 
 TEST_F(BrokerTest, MalformedFramesAreCountedAndDropped) {

@@ -1,0 +1,102 @@
+#include "worker/request_assets.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+#include "api/field_error.h"
+#include "common/assets/asset_id.h"
+#include "common/assets/mesh_file.h"
+#include "common/assets/mesh_import.h"
+
+namespace skyfarm {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The format named by the file's extension, else guessed from its bytes.
+std::optional<std::string> mesh_format(const fs::path& path, std::string_view bytes) {
+  std::string ext = path.extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (assets::is_mesh_format(ext)) return ext;
+  return assets::detect_mesh_format(bytes);
+}
+
+// The imported file's id and mesh, or an error sentence.
+std::string import_file(const fs::path& path, const std::string& shown, std::string* id,
+                        std::shared_ptr<const assets::TriangleMesh>* out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    const bool exists = fs::exists(path, ec);
+    return "cannot read " + shown + ": " + (exists ? "permission denied or not a file" : "no such file");
+  }
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return "cannot read " + shown + ": read error";
+  const std::optional<std::string> format = mesh_format(path, bytes);
+  if (!format) return "cannot import " + shown + ": not a mesh file this importer knows (obj, ply, stl, gltf, glb)";
+  auto mesh = std::make_shared<assets::TriangleMesh>();
+  std::string error;
+  if (!assets::import_mesh(bytes, *format, assets::MeshLimits{}, mesh.get(), &error))
+    return "cannot import " + shown + ": " + error;
+  *id = assets::asset_id_of(assets::encode_mesh_file(*mesh));
+  *out = std::move(mesh);
+  return "";
+}
+
+}  // namespace
+
+std::shared_ptr<const assets::TriangleMesh> LocalMeshSource::mesh(std::string_view id) const {
+  if (const auto it = imported_.find(id); it != imported_.end()) return it->second;
+  return cache_.mesh(id);
+}
+
+std::unique_ptr<LocalMeshSource> resolve_request_assets(nlohmann::json* request, const std::string& base_dir,
+                                                        AssetDiskCache* disk) {
+  auto source = std::make_unique<LocalMeshSource>(disk);
+  if (!request->is_object()) return source;
+  const auto objects = request->find("objects");
+  if (objects == request->end() || !objects->is_array()) return source;
+  std::vector<api::FieldError> errors;
+  std::map<std::string, std::string> imported;  // path -> id: a file named twice is read once
+  for (std::size_t i = 0; i < objects->size(); ++i) {
+    nlohmann::json& object = (*objects)[i];
+    if (!object.is_object()) continue;
+    const auto asset = object.find("asset");
+    if (asset == object.end() || !asset->is_string()) continue;
+    const std::string field = "objects[" + std::to_string(i) + "].asset";
+    const std::string value = asset->get<std::string>();
+    if (assets::is_asset_id(value)) {
+      try {
+        (void)source->mesh(value);  // loads it now, so a missing one is named by its field
+      } catch (const std::exception& e) {
+        errors.push_back({field, e.what(), ""});
+      }
+      continue;
+    }
+    if (value.empty()) continue;  // the parser says what an asset must be
+    const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
+    std::string id;
+    if (const auto seen = imported.find(path.string()); seen != imported.end()) {
+      id = seen->second;
+    } else {
+      std::shared_ptr<const assets::TriangleMesh> mesh;
+      if (std::string error = import_file(path, value, &id, &mesh); !error.empty()) {
+        errors.push_back({field, error, ""});
+        continue;
+      }
+      source->add(id, std::move(mesh));
+      imported.emplace(path.string(), id);
+    }
+    *asset = id;
+  }
+  if (!errors.empty()) throw api::ValidationError(std::move(errors));
+  return source;
+}
+
+}  // namespace skyfarm
