@@ -32,7 +32,7 @@ const glm::dvec3 kMirrorCentre{-1.3, 5.0, 0.5};  // ground-origin east-north-up,
 // The three reference balls (api/examples/objects_reference_balls.json).
 Json reference_balls() {
   return Json::parse(R"([
-    {"name": "mirror ball", "shape": "sphere", "material": {"name": "aluminium", "roughness": 0},
+    {"name": "chrome ball", "shape": "sphere", "material": {"name": "chrome", "roughness": 0},
      "translate_m": [-1.3, 5, 0.5], "scale": 0.5},
     {"name": "grey ball", "shape": "sphere", "albedo": 0.18, "translate_m": [0, 5, 0.5], "scale": 0.5},
     {"name": "white ball", "shape": "sphere", "albedo": 0.8, "translate_m": [1.3, 5, 0.5], "scale": 0.5}])");

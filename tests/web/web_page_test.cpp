@@ -183,7 +183,7 @@ TEST_F(WebPage, ReferenceBallsAreSentInFrontOfTheCameraAndRendered) {
   EXPECT_FALSE(driver.execute("return document.querySelector('#reference-balls').checked;").get<bool>());
   set_value(driver, "#projection", "perspective");
   driver.type("#altitude", "1.6");
-  driver.type("#yaw", "90");  // east: the balls go 5 m east, the mirror ball to the north
+  driver.type("#yaw", "90");  // east: the balls go 5 m east, the chrome ball to the north
   driver.type("#pitch", "-10");
   driver.type("#width", "32");
   driver.type("#height", "18");
@@ -202,7 +202,7 @@ TEST_F(WebPage, ReferenceBallsAreSentInFrontOfTheCameraAndRendered) {
   ASSERT_EQ(sent.size(), 1u) << sent.dump();
   const nlohmann::json objects = nlohmann::json::parse(sent[0].get<std::string>())["objects"];
   ASSERT_EQ(objects.size(), 3u) << sent.dump();
-  EXPECT_EQ(objects[0]["material"], nlohmann::json::parse(R"({"name": "aluminium", "roughness": 0})"));
+  EXPECT_EQ(objects[0]["material"], nlohmann::json::parse(R"({"name": "chrome", "roughness": 0})"));
   EXPECT_EQ(objects[1]["albedo"], 0.18);
   EXPECT_EQ(objects[2]["albedo"], 0.8);
   EXPECT_EQ(objects[0]["translate_m"], nlohmann::json::parse("[5, 1.3, 0.5]"));

@@ -192,7 +192,7 @@ function setPath(object, path, value) {
 }
 
 // The reference balls of a lighting artist, on the ground in front of a
-// camera of azimuth `yawDeg`: a mirror (smooth aluminium), a grey card's 18 %
+// camera of azimuth `yawDeg`: a chrome mirror (smooth chromium), a grey card's 18 %
 // and a white 80 % ball, 0.5 m in radius, 5 m ahead, 1.3 m apart, left to
 // right (docs/request-schema.md, objects).  Millimetre positions keep the
 // request short.
@@ -202,7 +202,7 @@ function referenceBalls(yawDeg) {
   const mm = (x) => Math.round(1000 * x) / 1000 + 0;  // + 0: no -0
   const at = (side) => [mm(5 * forward[0] + 1.3 * side * right[0]), mm(5 * forward[1] + 1.3 * side * right[1]), 0.5];
   return [
-    { name: "mirror ball", shape: "sphere", material: { name: "aluminium", roughness: 0 }, translate_m: at(-1), scale: 0.5 },
+    { name: "chrome ball", shape: "sphere", material: { name: "chrome", roughness: 0 }, translate_m: at(-1), scale: 0.5 },
     { name: "grey ball", shape: "sphere", albedo: 0.18, translate_m: at(0), scale: 0.5 },
     { name: "white ball", shape: "sphere", albedo: 0.8, translate_m: at(1), scale: 0.5 },
   ];
