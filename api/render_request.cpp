@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "api/object_fields.h"
+
 namespace skyfarm::api {
 namespace {
 
@@ -150,7 +152,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   if (!body.is_object()) throw ValidationError({FieldError{"", "must be a JSON object", value_text(body)}});
   Fields top(body, "", e);
   top.allow_only({"location", "time", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output",
-                  "seed", "priority"});
+                  "seed", "priority", "objects"});
   RenderRequest r;
   read_location(top, r.location);
   read_time(top, r.time, r.time_text);
@@ -158,12 +160,15 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   require_time_or_sun(top);
   read_camera(top, r.camera);
   read_atmosphere(top, r.atmosphere);
+  read_objects(top, r.objects);
   read_spectral(top, r.spectral);
   read_quality(top, r.quality);
   read_method(top, r.method);
   read_output(top, r.output);
   read_seed(top, r.seed);
   top.integer("priority", 0, 100, r.priority);
+  if (r.method == Method::kLut && !r.objects.empty())
+    e.add("objects", "the lut method renders the sky alone: objects need \"method\": \"path\"");
   e.throw_if_any();
   return r;
 }
@@ -212,7 +217,7 @@ RenderRequest parse_render_request(const nlohmann::json& body) {
 }
 
 nlohmann::json to_canonical_json(const RenderRequest& r) {
-  return {{"location", location_json(r.location)},
+  Json j = {{"location", location_json(r.location)},
           {"time", time_json(r.time)},
           {"sun", sun_json(r.sun)},
           {"camera", camera_json(r.camera)},
@@ -230,6 +235,9 @@ nlohmann::json to_canonical_json(const RenderRequest& r) {
             {"half", r.output.half}}},
           {"seed", r.seed},
           {"priority", r.priority}};
+  // Written only when there are objects: requests without keep their text.
+  if (!r.objects.empty()) j["objects"] = objects_json(r.objects);
+  return j;
 }
 
 std::string canonical_text(const RenderRequest& request) { return to_canonical_json(request).dump(); }

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -13,6 +14,7 @@
 #include "api/json_fields.h"
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera_spec.h"
+#include "common/objects/object_spec.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
 
@@ -63,6 +65,7 @@ struct RenderRequest {
   SunSpec sun;
   CameraSpec camera;
   AtmosphereSpec atmosphere;
+  std::vector<ObjectSpec> objects;  // api/object_fields.h
   SpectralSpec spectral;
   QualitySpec quality;
   Method method = Method::kPath;

@@ -119,6 +119,8 @@ bool read_tables(const Fields& f, material::SurfaceSpec& s) {
   return e.size() == before;
 }
 
+}  // namespace
+
 void read_material(const Fields& f, material::SurfaceSpec& s) {
   f.allow_only({"name", "kind", "wavelengths_nm", "n", "k", "albedo", "roughness", "distribution",
                 "multiple_bounce"});
@@ -169,6 +171,8 @@ void read_material(const Fields& f, material::SurfaceSpec& s) {
   }
 }
 
+namespace {
+
 Json column_json(const std::vector<double>& values) {
   Json a = Json::array();
   for (double x : values) a.push_back(x == 0.0 ? 0.0 : x);
@@ -201,7 +205,9 @@ void read_ground(const Fields& f, AtmosphereSpec& out) {
   if (e.size() == before) out.ground_material = std::move(s);
 }
 
-Json ground_json(const material::SurfaceSpec& s) {
+Json ground_json(const material::SurfaceSpec& s) { return {{"material", material_json(s)}}; }
+
+Json material_json(const material::SurfaceSpec& s) {
   Json m = {{"name", s.name},
             {"roughness", Json::array({s.roughness_x, s.roughness_y})},
             {"distribution", name_of(kDistributions, s.distribution)},
@@ -216,7 +222,7 @@ Json ground_json(const material::SurfaceSpec& s) {
       if (!s.k.empty()) m["k"] = column_json(s.k);
     }
   }
-  return {{"material", m}};
+  return m;
 }
 
 }  // namespace skyfarm::api

@@ -20,6 +20,10 @@
 
 namespace skyfarm::api {
 
+// Reads a "material" object `f` (the fields above) into s; errors name its fields.
+void read_material(const Fields& f, material::SurfaceSpec& s);
+// The canonical form of a "material" object.
+Json material_json(const material::SurfaceSpec& surface);
 // Reads "ground" of the atmosphere object `f` into out.ground_material.
 void read_ground(const Fields& f, AtmosphereSpec& out);
 // The canonical form of a ground material ({"material": {...}}).

@@ -15,7 +15,7 @@ set(SKYFARM_DATA_FILES
   spa_periodic_terms.csv spa_nutation_terms.csv
   # Surfaces: optical constants and ground albedos (common/material/material_library.cpp).
   metal_nk_au_johnson_christy1972.csv metal_nk_ag_johnson_christy1972.csv
-  metal_nk_cu_johnson_christy1972.csv metal_nk_al_rakic1995.csv
+  metal_nk_cu_johnson_christy1972.csv metal_nk_al_rakic1995.csv metal_nk_cr_johnson_christy1974.csv
   water_nk_hale_querry1973.csv water_sellmeier_daimon_masumura2007_20C.csv
   ice_nk_warren_brandt2008.csv
   glass_n_bk7_sellmeier_schott.csv glass_n_bk7_k_schott.csv

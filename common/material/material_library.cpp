@@ -11,13 +11,13 @@ namespace skyfarm::material {
 namespace {
 
 constexpr std::array kIds = {
-    MaterialId::kGold,  MaterialId::kSilver, MaterialId::kCopper, MaterialId::kAluminium, MaterialId::kWater,
+    MaterialId::kGold,  MaterialId::kSilver, MaterialId::kCopper, MaterialId::kAluminium, MaterialId::kChrome, MaterialId::kWater,
     MaterialId::kIce,   MaterialId::kBk7,    MaterialId::kFusedSilica, MaterialId::kGrass, MaterialId::kSand,
     MaterialId::kLoam,  MaterialId::kConcrete, MaterialId::kSnow,
 };
 
 constexpr std::array<std::string_view, kIds.size()> kNames = {
-    "gold", "silver", "copper", "aluminium", "water", "ice", "bk7", "fused_silica",
+    "gold", "silver", "copper", "aluminium", "chrome", "water", "ice", "bk7", "fused_silica",
     "grass", "sand", "loam", "concrete", "snow",
 };
 
@@ -50,6 +50,8 @@ Material load(MaterialId id) {
       return {name, MaterialKind::kConductor, nk_table("metal_nk_cu_johnson_christy1972.csv", name)};
     case MaterialId::kAluminium:
       return {name, MaterialKind::kConductor, nk_table("metal_nk_al_rakic1995.csv", name)};
+    case MaterialId::kChrome:
+      return {name, MaterialKind::kConductor, nk_table("metal_nk_cr_johnson_christy1974.csv", name)};
     case MaterialId::kWater: {
       // Daimon's Sellmeier n is given to 5 decimals where Hale & Querry's
       // table has 3; the table supplies k, which the formula cannot.

@@ -5,6 +5,7 @@
 //            conductors (n + i k, tabulated)
 //              gold, silver, copper  Johnson & Christy (1972), evaporated films
 //              aluminium             Rakić (1995), evaporated film
+//              chrome                Johnson & Christy (1974), chromium films
 //            dielectrics (n + i k)
 //              water         n: Daimon & Masumura (2007) Sellmeier, 20 °C;
 //                            k: Hale & Querry (1973), 25 °C
@@ -43,6 +44,7 @@ enum class MaterialId {
   kSilver,
   kCopper,
   kAluminium,
+  kChrome,
   kWater,
   kIce,
   kBk7,

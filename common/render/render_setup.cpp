@@ -2,12 +2,18 @@
 
 #include <string>
 
+#include "common/objects/placed_objects.h"
+
 namespace skyfarm {
 
-RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* /*meshes*/) {
+RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes) {
   RenderSetup s;
   s.scene = std::make_unique<Scene>(Scene::from_specs(spec.atmosphere, spec.sun, spec.location, spec.time,
                                                       spec.lambda_min_nm, spec.lambda_max_nm));
+  // Objects only when there are some: a plain sky builds nothing for them.
+  if (!spec.objects.empty())
+    s.scene->set_objects(
+        std::make_shared<PlacedObjects>(spec.objects, s.scene->atmosphere().planet_radius_m(), meshes));
   s.camera = std::make_unique<Camera>(spec.camera, s.scene->observer());
   s.plan = render_plan_for(spec, s.scene->sun());
   return s;
@@ -17,14 +23,16 @@ RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun) {
   constexpr int kTileSize = 32, kSamplesPerPass = 16;
   const bool lut = spec.lut;
   // A ground that is not Lambertian looks different from every direction
-  // (no pooling), and an anisotropic one is not symmetric about the sun.
+  // (no pooling), and an anisotropic one is not symmetric about the sun;
+  // objects break both (they stand on the ground, anywhere about the sun).
   const std::optional<material::SurfaceSpec>& ground = spec.atmosphere.ground_material;
+  const bool objects = !spec.objects.empty();
   const bool glossy_ground = ground && !(ground->kind == material::MaterialKind::kDiffuse && ground->smooth());
   // The LUT renderer is deterministic: one sample per pixel and batch, one pass.
   RenderPlan plan = make_render_plan(spec.camera.width, spec.camera.height, spec.lambda_min_nm, spec.lambda_max_nm,
                                      spec.batches, lut ? 1 : spec.samples_per_pixel, spec.seed, kTileSize,
                                      lut ? 1 : kSamplesPerPass,
-                                     (!ground || ground->isotropic()) &&
+                                     !objects && (!ground || ground->isotropic()) &&
                                          mirror_symmetric(spec.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
@@ -32,7 +40,7 @@ RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun) {
   plan.adaptive = !lut && spec.adaptive && plan.passes >= 2;
   // An observer on the ground sees one ground point in every downward
   // direction (common/film/ground_pool.h).
-  if (!lut && spec.location.altitude_m == 0.0 && !glossy_ground) plan.pooled_ground_row = first_ground_row(spec.camera);
+  if (!lut && spec.location.altitude_m == 0.0 && !glossy_ground && !objects) plan.pooled_ground_row = first_ground_row(spec.camera);
   return plan;
 }
 

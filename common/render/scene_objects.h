@@ -24,6 +24,7 @@ struct SurfaceHit {
   glm::dvec3 tangent{1.0, 0.0, 0.0};  // a unit tangent: the anisotropic roughness_x axis
   const material::Surface* surface = nullptr;  // the object's material (never null)
   double offset_m = 1e-6;     // how far rays leaving the hit start off the surface
+  bool solid = false;         // the object encloses a volume (n points out of it); else a two-sided sheet
 };
 
 class SceneObjects {

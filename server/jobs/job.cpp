@@ -43,6 +43,20 @@ nlohmann::json ground_report(const AtmosphereSpec& spec, const Atmosphere& atmos
   return g;
 }
 
+// What the scene holds besides the sky: objects by shape, and whether the
+// scene builds a BVH (only mesh objects need one).
+nlohmann::json objects_report(const std::vector<ObjectSpec>& objects) {
+  static constexpr const char* kNames[] = {"sphere", "disc", "rectangle", "box", "mesh"};
+  nlohmann::json shapes = nlohmann::json::object();
+  bool bvh = false;
+  for (const ObjectSpec& o : objects) {
+    const std::string name = kNames[static_cast<int>(o.shape)];
+    shapes[name] = shapes.value(name, 0) + 1;
+    bvh = bvh || o.shape == ShapeKind::kMesh;
+  }
+  return {{"count", objects.size()}, {"shapes", shapes}, {"bvh", bvh}};
+}
+
 }  // namespace
 
 nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& plan) {
@@ -54,13 +68,15 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
     if (!request.atmosphere.aerosol || request.atmosphere.aerosol->optical_depth_550 <= 0.0)
       skipped.push_back("aerosol");
   }
-  return {{"constituents", constituents}, {"skipped", skipped},       {"ground", ground_report(request.atmosphere, atmosphere)},
+  nlohmann::json report = {{"constituents", constituents}, {"skipped", skipped},       {"ground", ground_report(request.atmosphere, atmosphere)},
           {"tiles", plan.tile_count()},
           {"batches", plan.batches},      {"passes", plan.passes},    {"samples_per_pass", plan.samples_per_pass},
           {"tile_size", plan.tile_size},  {"units", plan.unit_count()},  {"mirrored", plan.mirrored},
           {"method", plan.lut ? "lut" : "path"}, {"roulette_control", plan.roulette_control},
           {"shadow_guide", plan.shadow_guide},     {"adaptive", plan.adaptive},
           {"pooled_ground_row", plan.pooled_ground_row >= 0 ? nlohmann::json(plan.pooled_ground_row) : nlohmann::json()}};
+  if (!request.objects.empty()) report["objects"] = objects_report(request.objects);
+  return report;
 }
 
 }  // namespace skyfarm::server

@@ -289,7 +289,7 @@ TEST(RenderRequestErrors, UnknownFieldsAreRejectedAtEveryLevel) {
   for (const auto& [body, message] : std::vector<std::pair<std::string, std::string>>{
            {with(R"("colour": 1)"),
             "colour: unknown field (allowed: location, time, sun, camera, atmosphere, spectral, quality, method, "
-            "output, seed, priority)"},
+            "output, seed, priority, objects)"},
            {with(R"("quality": {"spp": 4})"),
             "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s, adaptive)"},
            {with(R"("output": {"png": true})"),
@@ -696,6 +696,82 @@ TEST(GroundMaterial, EveryBadMaterialIsAnErrorNamingItsField) {
   const auto both = errors_of(with(R"("atmosphere": {"ground_albedo": 0.2, "ground": {"material": {"name": "snow"}}})"));
   ASSERT_EQ(both.size(), 1u);
   EXPECT_EQ(both.front().path, "atmosphere.ground");
+}
+
+// "objects": shapes, the Lambertian shorthand, placements and their
+// canonical spellings; a request without objects writes none (its hash, and
+// so its cached results, are unchanged).
+TEST(SceneObjects, ObjectsParseWithDefaultsAndOneCanonicalSpelling) {
+  const std::string id = "sha256:" + std::string(64, 'c');
+  const RenderRequest r = parse_render_request(with(
+      R"("objects": [{"name": "chrome ball", "shape": "sphere", "material": {"name": "chrome"},)"
+      R"( "translate_m": [0, 5, 0.5], "scale": 0.5},)"
+      R"( {"shape": "box", "albedo": 0.18, "rotate_deg": [350, -90, 180], "scale": [1, 2, -3]},)"
+      R"( {"shape": "mesh", "asset": ")" + id + R"("}])"));
+  ASSERT_EQ(r.objects.size(), 3u);
+  EXPECT_EQ(r.objects[0].name, "chrome ball");
+  EXPECT_EQ(r.objects[0].shape, ShapeKind::kSphere);
+  EXPECT_EQ(r.objects[0].placement.scale, glm::dvec3(0.5));
+  EXPECT_EQ(r.objects[0].placement.translate_m, glm::dvec3(0, 5, 0.5));
+  EXPECT_EQ(r.objects[0].material.kind, material::MaterialKind::kConductor);
+  EXPECT_EQ(r.objects[1].placement.rotate_deg, glm::dvec3(-10, -90, 180));
+  EXPECT_EQ(r.objects[1].placement.scale, glm::dvec3(1, 2, -3));
+  EXPECT_EQ(r.objects[1].material.albedo, (std::vector<double>{0.18, 0.18}));
+  EXPECT_EQ(r.objects[2].asset, id);
+  EXPECT_EQ(r.objects[2].material.albedo, (std::vector<double>{0.5, 0.5}));  // the default
+  const Json canonical = to_canonical_json(r);
+  ASSERT_TRUE(canonical.contains("objects"));
+  EXPECT_EQ(canonical["objects"][1]["albedo"], 0.18);
+  EXPECT_EQ(canonical["objects"][0]["scale"], Json::array({0.5, 0.5, 0.5}));
+  EXPECT_EQ(canonical_text(parse_render_request(canonical_text(r))), canonical_text(r));
+  // The same scene spelled otherwise: the same canonical text.
+  const RenderRequest same = parse_render_request(with(
+      R"("objects": [{"name": "chrome ball", "shape": "sphere", "material": {"name": "chrome", "roughness": 0},)"
+      R"( "translate_m": [0, 5, 0.5], "rotate_deg": [0, 360, -360], "scale": [0.5, 0.5, 0.5]},)"
+      R"( {"shape": "box", "albedo": 0.18, "rotate_deg": [-10, 270, -180], "scale": [1, 2, -3]},)"
+      R"( {"shape": "mesh", "asset": ")" + id + R"(", "albedo": 0.5}])"));
+  EXPECT_EQ(canonical_text(same), canonical_text(r));
+  EXPECT_FALSE(to_canonical_json(parse_render_request(with(""))).contains("objects"));
+  EXPECT_FALSE(to_canonical_json(parse_render_request(with(R"("objects": [])"))).contains("objects"));
+}
+
+TEST(SceneObjects, EveryBadObjectIsAnErrorNamingItsField) {
+  const std::string id = "sha256:" + std::string(64, 'c');
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({})", "objects[0].shape"},
+      {R"({"shape": "torus"})", "objects[0].shape"},
+      {R"({"shape": "mesh"})", "objects[0].asset"},
+      {R"({"shape": "mesh", "asset": "bunny.obj"})", "objects[0].asset"},
+      {R"({"shape": "mesh", "asset": "sha256:ABC"})", "objects[0].asset"},
+      {R"({"shape": "sphere", "asset": ")" + id + R"("})", "objects[0].asset"},
+      {R"({"shape": "sphere", "albedo": 1.5})", "objects[0].albedo"},
+      {R"({"shape": "sphere", "albedo": 0.5, "material": {"name": "gold"}})", "objects[0].albedo"},
+      {R"({"shape": "sphere", "material": {"name": "unobtainium"}})", "objects[0].material.name"},
+      {R"({"shape": "sphere", "material": "gold"})", "objects[0].material"},
+      {R"({"shape": "sphere", "scale": 0})", "objects[0].scale"},
+      {R"({"shape": "sphere", "scale": [1, 0, 1]})", "objects[0].scale[1]"},
+      {R"({"shape": "sphere", "scale": [1, 1]})", "objects[0].scale"},
+      {R"({"shape": "sphere", "scale": "big"})", "objects[0].scale"},
+      {R"({"shape": "sphere", "translate_m": [0, 1e9, 0]})", "objects[0].translate_m[1]"},
+      {R"({"shape": "sphere", "rotate_deg": [0, 400, 0]})", "objects[0].rotate_deg[1]"},
+      {R"({"shape": "sphere", "colour": "red"})", "objects[0].colour"},
+      {R"({"shape": "sphere", "name": ""})", "objects[0].name"},
+  };
+  for (const auto& [object, field] : cases) {
+    const auto errors = errors_of(with(R"("objects": [)" + object + "]"));
+    ASSERT_FALSE(errors.empty()) << object;
+    bool named = false;
+    for (const auto& e : errors) named = named || e.path == field;
+    EXPECT_TRUE(named) << object << " -> " << errors.front().message();
+  }
+  EXPECT_FALSE(errors_of(with(R"("objects": {"shape": "sphere"})")).empty());
+  EXPECT_FALSE(errors_of(with(R"("objects": [3])")).empty());
+  std::string many = R"("objects": [)";
+  for (int i = 0; i <= 1000; ++i) many += std::string(i ? "," : "") + R"({"shape": "sphere"})";
+  EXPECT_FALSE(errors_of(with(many + "]")).empty());
+  const auto lut = errors_of(with(R"("method": "lut", "objects": [{"shape": "sphere"}])"));
+  ASSERT_EQ(lut.size(), 1u);
+  EXPECT_EQ(lut.front().path, "objects");
 }
 
 }  // namespace
