@@ -224,7 +224,7 @@ function readRequest() {
     setPath(body, input.dataset.field, input.valueAsNumber);
   }
   if (body.camera.projection === "equirectangular") delete body.camera.fov_deg;  // ignored there
-  if ($("#reference-balls").checked) body.objects = referenceBalls(body.camera.yaw_deg ?? 0);
+  if (kind() === "render" && $("#reference-balls").checked) body.objects = referenceBalls(body.camera.yaw_deg ?? 0);
   const zone = $("#time-zone").value;
   const timed = (input) => {
     try { return isoWithOffset(input.value, zone); } catch (error) {
