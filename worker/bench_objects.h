@@ -8,7 +8,9 @@
 //         the same view without them: the wide view (96x54, fov 55, 8 spp,
 //         a tenth of the pixels on a ball) and the mirror-ball close-up
 //         (64x64, fov 15, 8 spp, half of them on it).  N runs each
-//         (default 5), medians.  One JSON line per view and scene.
+//         (default 5), medians of paths per CPU second of the process
+//         ("median", the rendering thread's work whatever else runs) and
+//         per wall second ("median_wall").  One JSON line per view and scene.
 // mirror  the close-up's error against time: a reference of R passes
 //         (default 256, 16 spp each; all threads, another seed), then K
 //         renders of P passes (default 3 and 32) with seeds 1..K; after
