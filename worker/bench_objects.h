@@ -15,11 +15,12 @@
 //         (default 256, 16 spp each; all threads, another seed), then K
 //         renders of P passes (default 3 and 32) with seeds 1..K; after
 //         passes 1, 2, 4, ... the relative RMS error of luminance over the
-//         pixels wholly on the mirror ball, sqrt(sum (Y - Y_ref)^2 /
+//         pixels wholly on the chrome ball, sqrt(sum (Y - Y_ref)^2 /
 //         sum Y_ref^2), and the elapsed time, medians over the seeds.  The
-//         sun's reflection (pixels of the reference above 50 x the ball's
-//         median) is left out, as the sun disk is from the renderer's own
-//         estimate: a few pixels 1e6 x the sky would be the whole error.
+//         pixels that may reflect the sun (the disk within the spread of
+//         their corners' reflections) are left out, as the disk is from
+//         the renderer's own estimate: a few pixels 1e5 x the sky, hit or
+//         missed by chance, would be the whole error.
 //         One JSON line per pass count, then the fitted slope of log error
 //         against log time (-1/2 for an unbiased estimator).
 #pragma once
