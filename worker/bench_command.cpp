@@ -17,6 +17,7 @@
 #include "worker/bench_convergence.h"
 #include "worker/bench_efficiency.h"
 #include "worker/bench_lut_vs_path.h"
+#include "worker/bench_objects.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
 
@@ -119,6 +120,8 @@ int run_bench_command(const std::vector<std::string>& args) {
       return run_bench_convergence(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "lut-vs-path") {
       return run_bench_lut_vs_path(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
+    } else if (args[i] == "objects") {
+      return run_bench_objects(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "efficiency") {
       return run_bench_efficiency(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "paths" || args[i] == "demo" || args[i] == "memory" || args[i] == "all") {
@@ -128,7 +131,9 @@ int run_bench_command(const std::vector<std::string>& args) {
                    "       skyfarm-worker bench convergence [--out DIR] [--passes N]\n"
                    "       skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] [--shadow-scale S] "
                    "[--sunlit-segments]\n"
-                   "       skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]\n";
+                   "       skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]\n"
+                   "       skyfarm-worker bench objects [paths|mirror|all] [--repeat N] [--passes P] [--seeds K] "
+                   "[--reference-passes R]\n";
       return 2;
     }
   }

@@ -5,6 +5,9 @@
 
 #include <gtest/gtest.h>
 
+#include "common/assets/mesh_file.h"
+#include "common/assets/mesh_import.h"
+#include "server/assets/asset_store.h"
 #include "tests/support/test_files.h"
 
 #include <algorithm>
@@ -37,6 +40,31 @@ std::vector<fs::path> json_files(const fs::path& dir, bool probes) {
   return out;
 }
 
+// An example's body as the farm would get it: a mesh object's "asset" that
+// is a file path (relative to the example's folder; skyfarm-worker render
+// reads it) becomes the id POST /v1/assets would answer for that file, the
+// SHA-256 of its imported canonical mesh.  A path that does not import is a
+// failure here, not a skip.
+std::string with_asset_ids(const fs::path& file) {
+  nlohmann::json body = nlohmann::json::parse(read_text(file));
+  if (!body.is_object() || !body.contains("objects") || !body["objects"].is_array()) return read_text(file);
+  for (auto& object : body["objects"]) {
+    if (!object.is_object() || !object.contains("asset") || !object["asset"].is_string()) continue;
+    const std::string asset = object["asset"].get<std::string>();
+    if (server::is_asset_id(asset)) continue;
+    const fs::path mesh_file = file.parent_path() / asset;
+    std::string format = mesh_file.extension().string();
+    if (!format.empty()) format.erase(0, 1);
+    assets::TriangleMesh mesh;
+    std::string error;
+    EXPECT_TRUE(fs::exists(mesh_file)) << mesh_file;
+    EXPECT_TRUE(assets::import_mesh(read_text(mesh_file), format, assets::MeshLimits{}, &mesh, &error))
+        << mesh_file << ": " << error;
+    object["asset"] = "sha256:" + server::sha256_hex(assets::encode_mesh_file(mesh));
+  }
+  return body.dump();
+}
+
 // The errors a body gets (empty when it parses).
 std::vector<FieldError> errors_of(std::string_view body) {
   try {
@@ -67,12 +95,32 @@ TEST(RenderRequestExamples, EveryGoodExampleParsesAndRoundTrips) {
   for (const auto& file : files) {
     SCOPED_TRACE(file.filename().string());
     RenderRequest r;
-    ASSERT_NO_THROW(r = parse_render_request(read_text(file)));
+    ASSERT_NO_THROW(r = parse_render_request(with_asset_ids(file)));
     const std::string canonical = canonical_text(r);
     RenderRequest again;
     ASSERT_NO_THROW(again = parse_render_request(canonical)) << canonical;
     EXPECT_EQ(canonical_text(again), canonical);
   }
+}
+
+// The mesh example names a mesh the repository ships, small enough to read.
+TEST(RenderRequestExamples, MeshExampleNamesAShippedSmallMesh) {
+  const auto body = nlohmann::json::parse(read_text(kExamples / "objects_mesh.json"));
+  int meshes = 0;
+  for (const auto& object : body.at("objects")) {
+    if (object.at("shape") != "mesh") continue;
+    ++meshes;
+    const fs::path file = kExamples / object.at("asset").get<std::string>();
+    SCOPED_TRACE(file.string());
+    assets::TriangleMesh mesh;
+    std::string error;
+    ASSERT_TRUE(assets::import_mesh(read_text(file), "obj", assets::MeshLimits{}, &mesh, &error)) << error;
+    EXPECT_GT(mesh.triangle_count(), 12u);
+    EXPECT_LE(mesh.triangle_count(), 500u);
+  }
+  EXPECT_EQ(meshes, 1);
+  const RenderRequest r = parse_render_request(with_asset_ids(kExamples / "objects_mesh.json"));
+  EXPECT_TRUE(server::is_asset_id(r.objects.at(0).asset)) << r.objects.at(0).asset;
 }
 
 TEST(RenderRequestExamples, EveryBadExampleGetsItsExpectedError) {

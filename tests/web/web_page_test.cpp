@@ -8,7 +8,8 @@
 // chosen and submitted in the form is followed until every frame of the strip
 // has loaded (exposed as the sequence is), plays (the shown frame changes),
 // offers its contact sheet and its video (or, without ffmpeg, says why not)
-// and is listed done.  Skipped (with the command that installs them) when
+// and is listed done.  "Reference balls" puts the three balls in the request,
+// in front of the camera.  Skipped (with the command that installs them) when
 // Chromium or chromedriver is missing.
 #include <gtest/gtest.h>
 
@@ -168,6 +169,56 @@ TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
   const std::string log = driver.log();
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
   EXPECT_EQ(log.find("Content Security Policy"), std::string::npos) << log;
+}
+
+// "Reference balls" adds the three balls in front of the camera, along its
+// yaw, to the request the page sends; the farm renders it to the end.
+TEST_F(WebPage, ReferenceBallsAreSentInFrontOfTheCameraAndRendered) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
+  // The bodies the page posts, kept as sent.
+  driver.execute("window.sentBodies = []; const send = window.fetch;"
+                 "window.fetch = (url, options) => { if (options && options.body) sentBodies.push(options.body);"
+                 "  return send(url, options); };");
+  EXPECT_FALSE(driver.execute("return document.querySelector('#reference-balls').checked;").get<bool>());
+  set_value(driver, "#projection", "perspective");
+  driver.type("#altitude", "1.6");
+  driver.type("#yaw", "90");  // east: the balls go 5 m east, the chrome ball to the north
+  driver.type("#pitch", "-10");
+  driver.type("#width", "32");
+  driver.type("#height", "18");
+  driver.type("#spp", "16");
+  driver.click(driver.find("#reference-balls"));
+  driver.click(driver.find("#submit"));
+
+  const bool done = driver.wait_until(
+      "const img = document.querySelector('#job-image');"
+      "return document.querySelector('#job-state').textContent === 'done' && img.complete && img.naturalWidth > 0;",
+      kRenderTimeout);
+  const std::string id = text_of(driver, "#job-id");
+  ASSERT_TRUE(done) << "render " << id << " state '" << text_of(driver, "#job-state") << "', problem '"
+                    << text_of(driver, "#form-problem") << "'\n" << driver.log();
+  const nlohmann::json sent = driver.execute("return sentBodies;");
+  ASSERT_EQ(sent.size(), 1u) << sent.dump();
+  const nlohmann::json objects = nlohmann::json::parse(sent[0].get<std::string>())["objects"];
+  ASSERT_EQ(objects.size(), 3u) << sent.dump();
+  EXPECT_EQ(objects[0]["material"], nlohmann::json::parse(R"({"name": "chrome", "roughness": 0})"));
+  EXPECT_EQ(objects[1]["albedo"], 0.18);
+  EXPECT_EQ(objects[2]["albedo"], 0.8);
+  EXPECT_EQ(objects[0]["translate_m"], nlohmann::json::parse("[5, 1.3, 0.5]"));
+  EXPECT_EQ(objects[1]["translate_m"], nlohmann::json::parse("[5, 0, 0.5]"));
+  EXPECT_EQ(objects[2]["translate_m"], nlohmann::json::parse("[5, -1.3, 0.5]"));
+  for (const auto& ball : objects) EXPECT_EQ(ball["scale"], 0.5) << ball.dump();
+  EXPECT_EQ(server.status(id)["state"], "done");
+
+  // Unticked, the next request has no objects.
+  driver.click(driver.find("#reference-balls"));
+  driver.click(driver.find("#submit"));
+  ASSERT_TRUE(driver.wait_until("return sentBodies.length === 2;", kPageTimeout)) << driver.log();
+  EXPECT_FALSE(nlohmann::json::parse(driver.execute("return sentBodies[1];").get<std::string>()).contains("objects"));
+
+  const std::string log = driver.log();
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
 }
 
 TEST_F(WebPage, TimelapseSubmittedFromThePageFillsTheStripPlaysAndIsListedDone) {

@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include <cmath>
 #include <string>
+#include <vector>
 #include <sys/wait.h>
 
 #include "common/image/exr_writer.h"
@@ -175,6 +176,37 @@ TEST(WorkerCli, BenchEfficiencyPrintsOneLinePerSun) {
   }
   EXPECT_EQ(n, 2);
   EXPECT_EQ(run_worker("bench efficiency --bogus").exit_code, 2);
+}
+
+// The objects bench, its paths part once: a line per view and scene, the
+// balls' line with its ratio to the empty sky; the mirror part small, its
+// error falling from the first pass to the last.
+TEST(WorkerCli, BenchObjectsPrintsPathsAndMirrorError) {
+  const CommandResult paths = run_worker("bench objects paths --repeat 1");
+  ASSERT_EQ(paths.exit_code, 0) << paths.out;
+  std::istringstream lines(paths.out);
+  int n = 0;
+  for (std::string line; std::getline(lines, line); ++n) {
+    const auto j = nlohmann::json::parse(line);
+    EXPECT_EQ(j["bench"], "objects_paths_per_second_per_core");
+    EXPECT_GT(j["median"].get<double>(), 0.0) << line;
+    EXPECT_EQ(j.contains("relative_to_empty"), j["scene"] == "reference_balls") << line;
+  }
+  EXPECT_EQ(n, 4);
+
+  const CommandResult mirror = run_worker("bench objects mirror --passes 4 --seeds 1 --reference-passes 8");
+  ASSERT_EQ(mirror.exit_code, 0) << mirror.out;
+  std::istringstream mirror_lines(mirror.out);
+  std::vector<nlohmann::json> errors;
+  for (std::string line; std::getline(mirror_lines, line);) {
+    const auto j = nlohmann::json::parse(line);
+    if (j["bench"] == "objects_mirror_reference") EXPECT_GT(j["mirror_pixels"].get<int>(), 500) << line;
+    if (j["bench"] == "objects_mirror_error") errors.push_back(j);
+  }
+  ASSERT_EQ(errors.size(), 3u) << mirror.out;  // after passes 1, 2 and 4
+  EXPECT_GT(errors.front()["median_relative_rms"].get<double>(), errors.back()["median_relative_rms"].get<double>())
+      << mirror.out;
+  EXPECT_EQ(run_worker("bench objects --bogus").exit_code, 2);
 }
 
 }  // namespace

@@ -191,6 +191,23 @@ function setPath(object, path, value) {
   node[keys.at(-1)] = value;
 }
 
+// The reference balls of a lighting artist, on the ground in front of a
+// camera of azimuth `yawDeg`: a chrome mirror (smooth chromium), a grey card's 18 %
+// and a white 80 % ball, 0.5 m in radius, 5 m ahead, 1.3 m apart, left to
+// right (docs/request-schema.md, objects).  Millimetre positions keep the
+// request short.
+function referenceBalls(yawDeg) {
+  const yaw = (yawDeg * Math.PI) / 180;
+  const forward = [Math.sin(yaw), Math.cos(yaw)], right = [Math.cos(yaw), -Math.sin(yaw)];
+  const mm = (x) => Math.round(1000 * x) / 1000 + 0;  // + 0: no -0
+  const at = (side) => [mm(5 * forward[0] + 1.3 * side * right[0]), mm(5 * forward[1] + 1.3 * side * right[1]), 0.5];
+  return [
+    { name: "chrome ball", shape: "sphere", material: { name: "chrome", roughness: 0 }, translate_m: at(-1), scale: 0.5 },
+    { name: "grey ball", shape: "sphere", albedo: 0.18, translate_m: at(0), scale: 0.5 },
+    { name: "white ball", shape: "sphere", albedo: 0.8, translate_m: at(1), scale: 0.5 },
+  ];
+}
+
 // The request body from the form, or throws {field input, message} for what
 // the browser can tell is wrong before sending (unreadable numbers, time zone).
 function readRequest() {
@@ -207,6 +224,7 @@ function readRequest() {
     setPath(body, input.dataset.field, input.valueAsNumber);
   }
   if (body.camera.projection === "equirectangular") delete body.camera.fov_deg;  // ignored there
+  if (kind() === "render" && $("#reference-balls").checked) body.objects = referenceBalls(body.camera.yaw_deg ?? 0);
   const zone = $("#time-zone").value;
   const timed = (input) => {
     try { return isoWithOffset(input.value, zone); } catch (error) {
@@ -233,10 +251,13 @@ function clearErrors() {
   box.replaceChildren();
 }
 
-// The input that shows errors of request field `field` ("camera.width").
+// The input that shows errors of request field `field` ("camera.width");
+// an array's element ("objects[1].albedo") shows at the array's input.
 function inputForField(field) {
+  const array = /^([^[]+)\[/.exec(field)?.[1];
   for (const input of form.querySelectorAll("[data-field]")) {
-    if (input.dataset.field.split(" ").includes(field)) return input;
+    const names = input.dataset.field.split(" ");
+    if (names.includes(field) || (array && names.includes(array))) return input;
   }
   return null;
 }
