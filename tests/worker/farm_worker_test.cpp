@@ -516,7 +516,10 @@ std::vector<std::uint8_t> local_mesh_unit_bytes(const std::string& request, int 
 TEST_F(FarmWorkerTest, AMeshAssetIsFetchedOnceAndRendersAsLocally) {
   const std::string id = assets::asset_id_of(tetra_file());
   std::atomic<int> reads{0};
-  server::BrokerOptions o = broker_options();
+  // Generous liveness on both sides: on a loaded machine a 0.5 s silence
+  // made the broker drop the busy worker and refuse its reconnection (its id
+  // still in use), which is not what this test is about.
+  server::BrokerOptions o = broker_options(50);
   o.asset_file = [&](const std::string& asked) -> std::optional<std::string> {
     ++reads;
     if (asked == id) return tetra_file();
@@ -529,6 +532,7 @@ TEST_F(FarmWorkerTest, AMeshAssetIsFetchedOnceAndRendersAsLocally) {
   const fs::path cache = fs::temp_directory_path() / ("skyfarm_fw_assets_" + std::to_string(::getpid()));
   fs::remove_all(cache);
   FarmWorkerOptions wo = worker_options(broker_->bound_endpoint());
+  wo.heartbeat_liveness = 50;
   wo.threads = 2;
   wo.asset_cache_dir = cache.string();
   WorkerThread& w = start_worker(wo);

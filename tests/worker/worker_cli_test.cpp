@@ -200,7 +200,9 @@ TEST(WorkerCli, BenchObjectsPrintsPathsAndMirrorError) {
   std::vector<nlohmann::json> errors;
   for (std::string line; std::getline(mirror_lines, line);) {
     const auto j = nlohmann::json::parse(line);
-    if (j["bench"] == "objects_mirror_reference") EXPECT_GT(j["mirror_pixels"].get<int>(), 500) << line;
+    if (j["bench"] == "objects_mirror_reference") {
+      EXPECT_GT(j["mirror_pixels"].get<int>(), 500) << line;
+    }
     if (j["bench"] == "objects_mirror_error") errors.push_back(j);
   }
   ASSERT_EQ(errors.size(), 3u) << mirror.out;  // after passes 1, 2 and 4

@@ -18,6 +18,7 @@
 #include "common/render/radiance_probe.h"
 #include "tests/support/analytic_spheres.h"
 #include "tests/support/sun_specs.h"
+#include "tests/support/sunlit_sphere.h"
 #include "tests/support/thin_layer.h"
 
 namespace skyfarm {
@@ -179,7 +180,9 @@ TEST(PlacedObjects, RaysLeavingAHitNeitherReHitNorLeak) {
       const Ray out{h->p + n * h->offset_m, w};
       const auto again = placed.intersect(out, 1e9);
       // Convex solids: leaving outward, the ray meets another object or nothing.
-      if (again) EXPECT_GT(again->t, 1e-3) << "re-hit at " << again->t;
+      if (again) {
+        EXPECT_GT(again->t, 1e-3) << "re-hit at " << again->t;
+      }
       const Ray in{h->p - n * h->offset_m, -w};
       const auto inside = placed.intersect(in, 1e9);
       ASSERT_TRUE(inside) << "leaked through";
@@ -212,7 +215,9 @@ TEST(PlacedObjects, SolidsAndSheets) {
     ASSERT_TRUE(h) << i;
     EXPECT_EQ(h->solid, expected[i]) << i;
     // The sheets stand upright (pitch 90): their normal +z turned to -y (south).
-    if (!expected[i]) EXPECT_NEAR(h->n.y, -1.0, 1e-12) << i;
+    if (!expected[i]) {
+      EXPECT_NEAR(h->n.y, -1.0, 1e-12) << i;
+    }
   }
 }
 
@@ -253,7 +258,7 @@ TEST(PlacedObjects, AMeshWithoutItsAssetNamesTheObject) {
 
 // The path tracer through PlacedObjects: a Lambertian sphere of albedo rho
 // under the sun's disk in (near) vacuum has L = rho L_sun sin^2(alpha) cos,
-// 0 on its far side (the derivation is in object_transport_test.cpp).
+// 0 on its far side (tests/support/sunlit_sphere.h).
 TEST(PlacedObjects, LambertianSphereUnderTheSunMatchesTheClosedForm) {
   const double rho = 0.8, sun_zenith = 40.0, camera_up = 1.5;
   AtmosphereSpec spec = testing::thin_hg_layer(1e-12, 1000.0, 0.0);
@@ -265,35 +270,7 @@ TEST(PlacedObjects, LambertianSphereUnderTheSunMatchesTheClosedForm) {
   ball.material = grey(rho);
   scene.set_objects(std::make_shared<PlacedObjects>(std::vector<ObjectSpec>{ball}, scene.atmosphere().planet_radius_m(),
                                                     nullptr));
-  const glm::dvec3 c_cam = centre - glm::dvec3(0, 0, camera_up);  // from the camera
-  const glm::dvec3 s = scene.sun().direction();
-  SampledWavelengths wl;
-  wl.lambda_nm = {450.0, 550.0, 650.0, 750.0};
-  wl.pdf.fill(1.0);
-  const SampledSpectrum Le = scene.medium().path_coefficients(wl, &scene.sun()).sun_radiance;
-  const double sin_alpha = std::sin(scene.sun().angular_radius_rad());
-  std::vector<glm::dvec3> dirs;
-  for (double dx : {-0.12, -0.06, 0.0, 0.06, 0.12})
-    for (double dz : {-0.1, 0.0, 0.1}) dirs.push_back(glm::normalize(c_cam + glm::dvec3(dx * 6, 0, dz * 6)));
-  const ProbeResult r = probe_radiance(scene, dirs, {450.0, 550.0, 650.0, 750.0}, 256, 7, 2);
-  EXPECT_EQ(r.counters.nonfinite, 0u);
-  int lit = 0, dark = 0;
-  for (std::size_t d = 0; d < dirs.size(); ++d) {
-    const double b = glm::dot(-c_cam, dirs[d]), q = glm::dot(c_cam, c_cam) - radius * radius;
-    ASSERT_GE(b * b - q, 0.0);
-    const glm::dvec3 n = glm::normalize((-b - std::sqrt(b * b - q)) * dirs[d] - c_cam);
-    const double cos_s = glm::dot(n, s);
-    if (std::abs(cos_s) < 2.0 * sin_alpha) continue;
-    for (int w = 0; w < 4; ++w) {
-      const double expected = cos_s > 0.0 ? rho * Le[w] * sin_alpha * sin_alpha * cos_s : 0.0;
-      EXPECT_NEAR(r.radiance[d][static_cast<std::size_t>(w)], expected,
-                  4.0 * r.standard_error[d][static_cast<std::size_t>(w)] + 1e-6 * Le[0] * sin_alpha * sin_alpha)
-          << "direction " << d;
-    }
-    (cos_s > 0.0 ? lit : dark) += 1;
-  }
-  EXPECT_GT(lit, 3);
-  EXPECT_GT(dark, 1);
+  testing::expect_sunlit_lambertian_sphere(scene, centre - glm::dvec3(0, 0, camera_up), radius, rho);
 }
 
 }  // namespace

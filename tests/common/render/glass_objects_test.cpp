@@ -8,6 +8,7 @@
 
 #include "tests/support/analytic_boxes.h"
 #include "tests/support/analytic_spheres.h"
+#include "tests/support/path_moments.h"
 #include "tests/support/sun_specs.h"
 #include "tests/support/thin_layer.h"
 
@@ -299,29 +300,13 @@ TEST(GlassObjects, GlassBallFocusesTheSunAtTheParaxialFocalLength) {
 // radiance: the transmission NEE from inside is consistent with the BSDF's
 // transmitted samples.  The ball is 5 m towards the sun (10 degrees up),
 // the pixel a tenth of the radius off its centre.
-struct Moments {
-  double mean = 0.0, variance = 0.0;
-};
+using Moments = testing::PathMoments;
 Moments moments(const Scene& scene, const glm::dvec3& view, SurfaceSunSampling strategy,
                 SurfaceMisHeuristic heuristic, int n) {
-  IntegratorOptions options;
-  options.surface_sun_sampling = strategy;
-  options.surface_mis_heuristic = heuristic;
-  const VolumePathIntegrator integrator(scene, options);
-  SampledWavelengths wl;
-  wl.lambda_nm.fill(550.0);
-  wl.pdf.fill(1.0);
-  PathCounters counters;
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < n; ++i) {
-    Sampler sampler(23, 0, static_cast<std::uint64_t>(i));
-    const double L = integrator.radiance(Ray{scene.observer(), view}, wl, sampler, &counters)[0];
-    sum += L;
-    sum2 += L * L;
-  }
-  EXPECT_EQ(counters.nonfinite, 0u);
-  const double mean = sum / n;
-  return {mean, std::max(0.0, sum2 / n - mean * mean)};
+  std::uint64_t nonfinite = 0;
+  const Moments m = testing::path_moments(scene, view, strategy, heuristic, n, 23, &nonfinite);
+  EXPECT_EQ(nonfinite, 0u);
+  return m;
 }
 
 TEST(GlassObjects, SunThroughARoughGlassBallAgreesForSunOnlyBsdfOnlyAndMis) {

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include "tests/support/analytic_spheres.h"
+#include "tests/support/path_moments.h"
+#include "tests/support/sunlit_sphere.h"
 #include "tests/support/sun_specs.h"
 #include "tests/support/thin_layer.h"
 
@@ -43,11 +45,8 @@ std::optional<glm::dvec3> normal_seen(const glm::dvec3& d, const glm::dvec3& c, 
   return glm::normalize(t * d - c);
 }
 
-// A Lambertian sphere of albedo rho under a uniform sun disk of radius alpha
-// and radiance L_sun, nothing else: L = (rho / pi) integral_disk n.w L_sun dw
-// = rho L_sun sin^2(alpha) (n.s), the disk wholly above the tangent plane
-// (the mean of w over a cone of half-angle alpha is s (1 + cos alpha) / 2
-// times its solid angle 2 pi (1 - cos alpha)).  On the far side: 0.
+// A Lambertian sphere under the sun's disk in vacuum: the closed form of
+// tests/support/sunlit_sphere.h.
 TEST(ObjectTransport, LambertianSphereUnderTheSunInVacuumIsRhoLSunSin2AlphaCos) {
   const double rho = 0.8, sun_zenith = 40.0;
   const Location at{0, 0, 1.5};
@@ -58,34 +57,7 @@ TEST(ObjectTransport, LambertianSphereUnderTheSunInVacuumIsRhoLSunSin2AlphaCos) 
   const double radius = 1.0;
   scene.set_objects(std::make_shared<testing::AnalyticSpheres>(
       scene.observer(), std::vector<testing::AnalyticSpheres::Sphere>{{centre, radius, &white}}));
-  const glm::dvec3 s = scene.sun().direction();
-  SampledWavelengths wl;
-  wl.lambda_nm = {450.0, 550.0, 650.0, 750.0};
-  wl.pdf.fill(1.0);
-  const SampledSpectrum Le = scene.medium().path_coefficients(wl, &scene.sun()).sun_radiance;
-  const double sin_alpha = std::sin(scene.sun().angular_radius_rad());
-  // Directions over the sphere's face, lit and unlit.
-  std::vector<glm::dvec3> dirs;
-  for (double dx : {-0.12, -0.06, 0.0, 0.06, 0.12})
-    for (double dz : {-0.1, 0.0, 0.1}) dirs.push_back(glm::normalize(centre + glm::dvec3(dx * 6, 0, dz * 6)));
-  const ProbeResult r = probe_radiance(scene, dirs, {450.0, 550.0, 650.0, 750.0}, 256, 7, 2);
-  EXPECT_EQ(r.counters.nonfinite, 0u);
-  int lit = 0, dark = 0;
-  for (std::size_t d = 0; d < dirs.size(); ++d) {
-    const auto n = normal_seen(dirs[d], centre, radius);
-    ASSERT_TRUE(n) << d;
-    const double cos_s = glm::dot(*n, s);
-    // Only where the whole disk is on one side of the tangent plane.
-    if (std::abs(cos_s) < 2.0 * sin_alpha) continue;
-    for (std::size_t w = 0; w < 4; ++w) {
-      const double expected = cos_s > 0.0 ? rho * Le[static_cast<int>(w)] * sin_alpha * sin_alpha * cos_s : 0.0;
-      EXPECT_NEAR(r.radiance[d][w], expected, 4.0 * r.standard_error[d][w] + 1e-6 * Le[0] * sin_alpha * sin_alpha)
-          << "direction " << d << " cos " << cos_s;
-    }
-    (cos_s > 0.0 ? lit : dark) += 1;
-  }
-  EXPECT_GT(lit, 3);
-  EXPECT_GT(dark, 1);
+  testing::expect_sunlit_lambertian_sphere(scene, centre, radius, rho);
 }
 
 // A white sphere on a white ground under a uniform sky of radiance 1, in a
@@ -156,30 +128,11 @@ TEST(ObjectTransport, ChromeBallReflectsTheSkyOfTheMirrorDirection) {
     }
 }
 
-// The mean and the variance of one path of L at 550 nm (all four slots at
-// 550 nm) along `view` with the given surface sun sampling.
-struct PathMoments {
-  double mean = 0.0, variance = 0.0;
-};
+using testing::PathMoments;
+
 PathMoments moments(const Scene& scene, const glm::dvec3& view, SurfaceSunSampling strategy, int n,
                     SurfaceMisHeuristic heuristic = SurfaceMisHeuristic::kBalance) {
-  IntegratorOptions options;
-  options.surface_sun_sampling = strategy;
-  options.surface_mis_heuristic = heuristic;
-  const VolumePathIntegrator integrator(scene, options);
-  SampledWavelengths wl;
-  wl.lambda_nm.fill(550.0);
-  wl.pdf.fill(1.0);
-  PathCounters counters;
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < n; ++i) {
-    Sampler sampler(21, 0, static_cast<std::uint64_t>(i));
-    const double L = integrator.radiance(Ray{scene.observer(), view}, wl, sampler, &counters)[0];
-    sum += L;
-    sum2 += L * L;
-  }
-  const double mean = sum / n;
-  return {mean, std::max(0.0, sum2 / n - mean * mean)};
+  return testing::path_moments(scene, view, strategy, heuristic, n, 21);
 }
 
 // MIS at a surface (Veach 1997, ch. 9): sun-only, BSDF-only and their MIS
