@@ -17,6 +17,7 @@
 #include "common/objects/placed_objects.h"
 #include "common/render/radiance_probe.h"
 #include "tests/support/analytic_spheres.h"
+#include "tests/support/flat_diffuse.h"
 #include "tests/support/sun_specs.h"
 #include "tests/support/sunlit_sphere.h"
 #include "tests/support/thin_layer.h"
@@ -26,15 +27,7 @@ namespace {
 
 constexpr double kR = 6360e3;  // the planet radius of these scenes, m
 
-material::SurfaceSpec grey(double albedo) {
-  material::SurfaceSpec s;
-  s.name = "grey";
-  s.custom = true;
-  s.kind = material::MaterialKind::kDiffuse;
-  s.wavelengths_nm = {300.0, 900.0};
-  s.albedo = {albedo, albedo};
-  return s;
-}
+material::SurfaceSpec grey(double albedo) { return testing::flat_diffuse(albedo); }
 
 ObjectSpec object(ShapeKind shape, glm::dvec3 translate, glm::dvec3 scale, glm::dvec3 rotate = glm::dvec3(0.0),
                   std::string asset = {}) {

@@ -8,6 +8,7 @@
 #include "tests/support/analytic_spheres.h"
 #include "tests/support/path_moments.h"
 #include "tests/support/sunlit_sphere.h"
+#include "tests/support/flat_diffuse.h"
 #include "tests/support/sun_specs.h"
 #include "tests/support/thin_layer.h"
 
@@ -26,15 +27,7 @@
 namespace skyfarm {
 namespace {
 
-material::SurfaceSpec white_lambertian(double albedo) {
-  material::SurfaceSpec s;
-  s.name = "white";
-  s.custom = true;
-  s.kind = material::MaterialKind::kDiffuse;
-  s.wavelengths_nm = {300.0, 900.0};
-  s.albedo = {albedo, albedo};
-  return s;
-}
+material::SurfaceSpec white_lambertian(double albedo) { return testing::flat_diffuse(albedo); }
 
 // Where the ray from the observer along d meets the sphere (centre c,
 // radius r, in the observer's frame): the outward normal there.
