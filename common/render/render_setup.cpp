@@ -1,12 +1,42 @@
 #include "common/render/render_setup.h"
 
+#include <optional>
+#include <stdexcept>
 #include <string>
 
+#include "common/assets/volume_source.h"
 #include "common/objects/placed_objects.h"
 
 namespace skyfarm {
 
-RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes) {
+namespace {
+
+// Seconds since J2000 (2000-01-01T12:00:00Z) that the wind has blown: the
+// clouds of a timelapse drift frame by frame; a render without a time has none.
+double wind_time_s(const std::optional<UtcInstant>& time) {
+  if (!time) return 0.0;
+  constexpr std::int64_t kJ2000_unix = 946728000;
+  return static_cast<double>(time->unix_seconds - kJ2000_unix) + time->fraction;
+}
+
+}  // namespace
+
+std::shared_ptr<const SceneClouds> make_scene_clouds(const RenderSpec& spec, double planet_radius_m,
+                                                     const assets::VolumeSource* volumes) {
+  if (spec.clouds.empty()) return nullptr;
+  std::vector<std::shared_ptr<const CloudField>> fields;
+  const double time_s = wind_time_s(spec.time);
+  for (const CloudLayerSpec& layer : spec.clouds.layers)
+    (void)layer, (void)time_s, throw std::runtime_error("cloud layers: not built yet");  // TEMP until CloudLayer lands
+  if (!spec.clouds.volumes.empty()) {
+    if (!volumes) throw std::runtime_error("cloud volumes need a volume source");
+    throw std::runtime_error("cloud volumes are not available in this build");
+  }
+  return std::make_shared<SceneClouds>(std::move(fields));
+}
+
+RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes,
+                              const assets::VolumeSource* volumes) {
   RenderSetup s;
   s.scene = std::make_unique<Scene>(Scene::from_specs(spec.atmosphere, spec.sun, spec.location, spec.time,
                                                       spec.lambda_min_nm, spec.lambda_max_nm));
@@ -14,6 +44,9 @@ RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* 
   if (!spec.objects.empty())
     s.scene->set_objects(
         std::make_shared<PlacedObjects>(spec.objects, s.scene->atmosphere().planet_radius_m(), meshes));
+  // Clouds likewise: a clear sky builds nothing and takes the same code.
+  if (!spec.clouds.empty())
+    s.scene->set_clouds(make_scene_clouds(spec, s.scene->atmosphere().planet_radius_m(), volumes));
   s.camera = std::make_unique<Camera>(spec.camera, s.scene->observer());
   s.plan = render_plan_for(spec, s.scene->sun());
   return s;

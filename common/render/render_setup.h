@@ -23,6 +23,7 @@
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera.h"
 #include "common/camera/camera_spec.h"
+#include "common/clouds/cloud_spec.h"
 #include "common/objects/object_spec.h"
 #include "common/film/error_estimate.h"
 #include "common/film/image.h"
@@ -40,6 +41,7 @@ struct RenderSpec {
   SunSpec sun;
   AtmosphereSpec atmosphere;
   std::vector<ObjectSpec> objects;  // none: the plain sky, no BVH built
+  CloudsSpec clouds;                // none: a clear sky, nothing built for clouds
   // The view, the wavelengths and the samples.
   CameraSpec camera;
   double lambda_min_nm = 360.0, lambda_max_nm = 830.0;
@@ -58,10 +60,17 @@ struct RenderSetup {
 
 namespace assets {
 class MeshSource;
-}
-// `meshes` resolves the mesh objects' asset ids; it may be null for a spec
-// without mesh objects (one with them then throws std::runtime_error).
-RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes = nullptr);
+class VolumeSource;
+}  // namespace assets
+// `meshes` resolves the mesh objects' asset ids, `volumes` the cloud
+// volumes'; either may be null for a spec without them (one with them then
+// throws std::runtime_error).
+RenderSetup make_render_setup(const RenderSpec& spec, const assets::MeshSource* meshes = nullptr,
+                              const assets::VolumeSource* volumes = nullptr);
+
+// The clouds of a spec on a planet of this radius, or null for a clear sky.
+std::shared_ptr<const SceneClouds> make_scene_clouds(const RenderSpec& spec, double planet_radius_m,
+                                                     const assets::VolumeSource* volumes);
 
 // The plan of a render (tiles, batches, passes, mirror symmetry), given its sun.
 RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun);

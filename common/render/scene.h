@@ -6,6 +6,8 @@
 //   ground_surface        the ground's material when it is not Lambertian
 //                         (null otherwise: a plain ground pays nothing new)
 //   objects               surfaces in the air (null: none, and none of their cost)
+//   clouds                cloud layers and volumes (null: a clear sky, which
+//                         takes exactly the code it always took)
 //   sun                   position, disk, irradiance
 //   observer_altitude_m   the camera / probe position above the ground (on +z)
 //   lambda_min/max_nm     the wavelengths paths may carry (majorants cover them)
@@ -20,6 +22,7 @@
 
 #include "common/atmosphere/atmosphere.h"
 #include "common/atmosphere/atmosphere_spec.h"
+#include "common/clouds/scene_clouds.h"
 #include "common/material/surface.h"
 #include "common/render/atmosphere_medium.h"
 #include "common/render/scene_objects.h"
@@ -41,6 +44,9 @@ class Scene {
   // The objects in the scene, or null.
   const SceneObjects* objects() const { return objects_.get(); }
   void set_objects(std::shared_ptr<const SceneObjects> objects) { objects_ = std::move(objects); }
+  // The clouds in the scene, or null.
+  const SceneClouds* clouds() const { return clouds_.get(); }
+  void set_clouds(std::shared_ptr<const SceneClouds> clouds) { clouds_ = std::move(clouds); }
   // Planet-centred observer position (0, 0, R + altitude).
   glm::dvec3 observer() const { return observer_; }
   double observer_altitude_m() const { return observer_.z - atmosphere_->planet_radius_m(); }
@@ -55,6 +61,7 @@ class Scene {
   std::unique_ptr<AtmosphereMedium> medium_;
   std::shared_ptr<const material::Surface> ground_surface_;
   std::shared_ptr<const SceneObjects> objects_;
+  std::shared_ptr<const SceneClouds> clouds_;
   Sun sun_;
   glm::dvec3 observer_;
   double lambda_min_, lambda_max_;
