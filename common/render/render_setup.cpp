@@ -57,15 +57,16 @@ RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun) {
   const bool lut = spec.lut;
   // A ground that is not Lambertian looks different from every direction
   // (no pooling), and an anisotropic one is not symmetric about the sun;
-  // objects break both (they stand on the ground, anywhere about the sun).
+  // objects break both (they stand on the ground, anywhere about the sun),
+  // and so do clouds (their shadows fall anywhere).
   const std::optional<material::SurfaceSpec>& ground = spec.atmosphere.ground_material;
-  const bool objects = !spec.objects.empty();
+  const bool uneven = !spec.objects.empty() || !spec.clouds.empty();
   const bool glossy_ground = ground && !(ground->kind == material::MaterialKind::kDiffuse && ground->smooth());
   // The LUT renderer is deterministic: one sample per pixel and batch, one pass.
   RenderPlan plan = make_render_plan(spec.camera.width, spec.camera.height, spec.lambda_min_nm, spec.lambda_max_nm,
                                      spec.batches, lut ? 1 : spec.samples_per_pixel, spec.seed, kTileSize,
                                      lut ? 1 : kSamplesPerPass,
-                                     !objects && (!ground || ground->isotropic()) &&
+                                     !uneven && (!ground || ground->isotropic()) &&
                                          mirror_symmetric(spec.camera, sun.azimuth_deg(), kTileSize));
   plan.lut = lut;
   plan.roulette_control = !lut && roulette_control_pays(sun.zenith_deg());
@@ -73,7 +74,7 @@ RenderPlan render_plan_for(const RenderSpec& spec, const Sun& sun) {
   plan.adaptive = !lut && spec.adaptive && plan.passes >= 2;
   // An observer on the ground sees one ground point in every downward
   // direction (common/film/ground_pool.h).
-  if (!lut && spec.location.altitude_m == 0.0 && !glossy_ground && !objects) plan.pooled_ground_row = first_ground_row(spec.camera);
+  if (!lut && spec.location.altitude_m == 0.0 && !glossy_ground && !uneven) plan.pooled_ground_row = first_ground_row(spec.camera);
   return plan;
 }
 

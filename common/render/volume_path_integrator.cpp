@@ -39,6 +39,7 @@ struct VolumePathIntegrator::RayExtent {
   double t_begin = 0.0, t_end = 0.0;
   bool hits_ground = false;
   std::optional<SurfaceHit> object;  // an object before the ground or space (then t_end is its t)
+  const CloudField* cloud = nullptr;  // a real collision in a cloud before them (then t_end is its t)
 };
 
 namespace {
@@ -143,6 +144,7 @@ struct VolumePathIntegrator::Vertex {
   const PathMajorants* shadow_majorants = nullptr;  // the coarse shells' rows
   SampledSpectrum beta, r_p;  // throughput and r_u of the path at the vertex
   const SurfaceVertex* surface = nullptr;  // a ground that is a material, not Lambertian
+  const CloudField* cloud = nullptr;       // a scattering in a cloud (its phase function)
 };
 
 // A ground vertex on a surface that is a material: the local frame (s east,
@@ -217,6 +219,18 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       if ((extent.object = scene_.objects()->intersect(ray, extent.t_end))) {
         extent.t_end = extent.object->t;
         extent.hits_ground = false;
+      }
+    }
+    // The clouds' first real collision on the segment (delta tracking in the
+    // clouds alone, scene_clouds.h): the air's tracking below then runs up
+    // to it, and the nearer of the two media's collisions is the sum's.
+    if (scene_.clouds() && extent.in_atmosphere && !st.in_solid && extent.t_end > extent.t_begin) {
+      if (const auto hit =
+              scene_.clouds()->sample_collision(ray, extent.t_begin, extent.t_end, sampler, &counters->collisions)) {
+        extent.t_end = hit->t;
+        extent.hits_ground = false;
+        extent.object.reset();
+        extent.cloud = hit->field;
       }
     }
     if (st.in_solid) {
@@ -465,6 +479,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   const Sun& sun = scene_.sun();
   const PathCoefficients& path = c.path;
   if (st->beta.is_zero()) return false;
+  if (extent.cloud) return scatter_in_cloud(*extent.cloud, ray->at(extent.t_end), c, depth, ray, st, L);
   if (extent.object) {
     // Two-sided: the side the ray came from; a solid that light crosses
     // keeps its outward normal (the ray may come from inside).
@@ -512,6 +527,34 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
   st->beta *= path.ground_albedo;
   st->r_l = st->r_u * (1.0 / pdf);
   st->mis_with_sun = scene_.sun_enabled && !sun.is_point();
+  st->mis_power = false;
+  st->sun_from_segment_estimator = false;
+  *ray = Ray{p, wi};
+  return survives(st, p, wi, depth, c, L);
+}
+
+// A real collision in a cloud at p: the grey single-scattering albedo
+// weighs the path (an absorption the same at every wavelength), the sun's
+// NEE with the cloud's phase function (balance heuristic against the phase
+// sample), then the next direction sampled exactly from the phase function.
+// The collision's distance pdf and the phase pdf are the same at every
+// wavelength, so the spectral-MIS ratios r_u change by nothing here.
+bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::dvec3& p, const PathContext& c,
+                                            int depth, Ray* ray, PathState* st, SampledSpectrum* L) const {
+  const CloudOptics& optics = cloud.optics();
+  st->beta *= optics.albedo;
+  if (st->beta.is_zero()) return false;
+  if (scene_.sun_enabled) {
+    Vertex v{p, ray->d, false, {}, nullptr, nullptr, &c.path, &c.coarse, st->beta, st->r_u};
+    v.cloud = &cloud;
+    *L += sample_sun(v, c.lambda, c.sampler, c.counters);
+  }
+  const glm::dvec3 wi = optics.phase.sample_direction(ray->d, c.sampler.next(), c.sampler.next());
+  const double pdf = optics.phase.eval(clamp_cos(glm::dot(ray->d, wi)));
+  if (!(pdf > 0.0)) return false;
+  // f / pdf = 1: beta and r_u unchanged; r_l the sun technique's pdf over this one.
+  st->r_l = st->r_u * (1.0 / pdf);
+  st->mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
   st->mis_power = false;
   st->sun_from_segment_estimator = false;
   *ray = Ray{p, wi};
@@ -741,6 +784,9 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
       f = v.path->ground_albedo * (kInvPi * cos_theta);
       pdf_scatter = SampledSpectrum(cos_theta * kInvPi);
     }
+  } else if (v.cloud) {
+    f = SampledSpectrum(v.cloud->optics().phase.eval(clamp_cos(glm::dot(v.wo_propagation, wi))));
+    pdf_scatter = f;
   } else {
     f = mixture_phase(*v.medium, *v.phases, clamp_cos(glm::dot(v.wo_propagation, wi)));
     const ShadowGuide* table = shadow_guide_at(v.p);  // (penumbra: the disk partly seen)
@@ -754,8 +800,16 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   if (ground_distance(radial, atmosphere.planet_radius_m()) >= 0.0) return SampledSpectrum(0.0);
   if (scene_.objects() && scene_.objects()->occluded(shadow, std::numeric_limits<double>::infinity()))
     return SampledSpectrum(0.0);
+  // The clouds' transmittance first: deep in a cloud it is 0 after a
+  // collision or two, and the air's tracking is then never paid for.
+  double T_clouds = 1.0;
+  if (scene_.clouds()) {
+    T_clouds = scene_.clouds()->transmittance(shadow, 0.0, std::numeric_limits<double>::infinity(), sampler,
+                                              &counters->collisions);
+    if (!(T_clouds > 0.0)) return SampledSpectrum(0.0);
+  }
   const SphereHit top = intersect_sphere(radial, atmosphere.top_radius_m());
-  SampledSpectrum T_ray(1.0), r_u_ray(1.0), r_l_ray(1.0);
+  SampledSpectrum T_ray(T_clouds), r_u_ray(1.0), r_l_ray(1.0);
   if (top.hit && top.t_far > 0.0 && options_.residual_ratio_tracking &&
       residual_tracking_pays(v.p, wi)) {
     const TrackedTransmittance tracked =
@@ -857,15 +911,21 @@ VolumePathIntegrator::SunlitSample VolumePathIntegrator::sunlit_single_scatterin
   const SampledSpectrum p = mixture_phase(mp, phases, clamp_cos(glm::dot(ray.d, wi)));
   const TrackedTransmittance T_cam = tracked_transmittance(ray, t, path, sampler, counters);
   const TrackedTransmittance T_sun = tracked_transmittance(to_sun, 1e300, path, sampler, counters);
+  // The camera side crosses no cloud (the segment ends at the clouds' first
+  // collision); the sun side may.
+  const double T_clouds =
+      scene_.clouds() ? scene_.clouds()->transmittance(to_sun, 0.0, 1e300, sampler, &counters->collisions) : 1.0;
   SunlitSample out;
-  out.L = T_cam.T * mp.sigma_s * p * T_sun.T * path.sun_radiance * (1.0 / (pdf_t * pdf_light));
+  out.L = T_cam.T * mp.sigma_s * p * T_sun.T * path.sun_radiance * (T_clouds / (pdf_t * pdf_light));
   out.r = pdf_t_all * (1.0 / pdf_t) * T_cam.r_l * T_sun.r_l;
   return out;
 }
 
 SampledSpectrum VolumePathIntegrator::transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda,
                                                     Sampler& sampler, PathCounters* counters) const {
-  return tracked_transmittance(ray, t_end, scene_.medium().path_coefficients(lambda), sampler, counters).T;
+  SampledSpectrum T = tracked_transmittance(ray, t_end, scene_.medium().path_coefficients(lambda), sampler, counters).T;
+  if (scene_.clouds()) T *= scene_.clouds()->transmittance(ray, 0.0, t_end, sampler, &counters->collisions);
+  return T;
 }
 
 TrackedTransmittance VolumePathIntegrator::tracked_transmittance(const Ray& ray, double t_end,

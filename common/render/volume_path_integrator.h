@@ -24,6 +24,15 @@
 // sun at more points (max_camera_majorant_scale; off by default since the
 // forced collisions below).
 //
+// Clouds (Scene::clouds(), scene_clouds.h): a grey medium added to the air.
+// Each segment first samples the clouds' first real collision by delta
+// tracking in the clouds alone; the air's tracking then runs up to it, so
+// the nearer collision of the two independent media is the sum's (their
+// transmittances multiply).  A cloud collision scatters by the cloud's
+// phase function with sun NEE (scatter_in_cloud); every shadow ray
+// multiplies in the clouds' ratio-tracked transmittance.  Grey clouds leave
+// the spectral-MIS ratios unchanged.  A clear sky takes none of this code.
+//
 // Options:
 //   max_depth         hard cap on scattering events (a cost bound; hits are
 //                     counted in PathCounters::depth_limit so tests keep it 0)
@@ -178,7 +187,8 @@ class VolumePathIntegrator {
 
   // An unbiased estimate of the transmittance between ray.o and ray.at(t_end)
   // at the path's wavelengths by ratio tracking, with the hero wavelength's
-  // majorants (no Russian roulette): E[result_i] = exp(-tau_i).
+  // majorants (the air's without Russian roulette; the clouds', when the
+  // scene has some, scene_clouds.h, with it): E[result_i] = exp(-tau_i).
   SampledSpectrum transmittance(const Ray& ray, double t_end, const SampledWavelengths& lambda, Sampler& sampler,
                                 PathCounters* counters) const;
 
@@ -228,6 +238,9 @@ class VolumePathIntegrator {
   SampledSpectrum trace(Ray ray, PathState st, int depth, const PathContext& c) const;
   bool scatter_in_medium(const glm::dvec3& p, const MediumPoint& mp, const PathPhases& phases, Sampler& sampler,
                          Ray* ray, PathState* st) const;
+  // A real collision in a cloud at p: sun NEE, then the next direction.
+  bool scatter_in_cloud(const CloudField& cloud, const glm::dvec3& p, const PathContext& c, int depth, Ray* ray,
+                        PathState* st, SampledSpectrum* L) const;
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
   // A surface that is a material (the ground's when it is not Lambertian, an
