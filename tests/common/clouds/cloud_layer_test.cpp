@@ -18,6 +18,7 @@
 #include "common/clouds/shell_intervals.h"
 #include "common/core/constants.h"
 #include "common/geometry/sphere_intersection.h"
+#include "common/render/render_setup.h"
 #include "common/sampling/sampler.h"
 
 namespace skyfarm {
@@ -294,6 +295,31 @@ TEST(CloudLayer, FramesAMinuteApartAreDifferentButCorrelated) {
   EXPECT_GT(differ, n / 10);
   EXPECT_GT(corr, 0.5);
   EXPECT_LT(corr, 0.999);
+}
+
+// The render setup drifts each layer by time since J2000 x its wind along
+// the observer's east (+x) and north (+y); a spec without a time does not.
+TEST(CloudLayer, TheRenderSetupDriftsLayersByTheWindSinceJ2000) {
+  RenderSpec spec;
+  CloudLayerSpec s = layer_spec(CloudType::kCumulus, 0.5);
+  s.wind_m_s = {12.0, -4.0};
+  spec.clouds.layers = {s};
+  spec.time = UtcInstant{946728000 + 3600, 0.5};  // J2000 + 3600.5 s
+  const auto clouds = make_scene_clouds(spec, kR, nullptr);
+  ASSERT_TRUE(clouds);
+  ASSERT_EQ(clouds->fields().size(), 1u);
+  const CloudLayer expected(s, kR, glm::dvec3(12.0 * 3600.5, -4.0 * 3600.5, 0.0)), still(s, kR, glm::dvec3(0.0));
+  spec.time.reset();
+  const auto timeless = make_scene_clouds(spec, kR, nullptr);
+  int differ = 0;
+  for (int i = 0; i < 500; ++i) {
+    const glm::dvec3 p = point_in_layer(s, 3e4 * (to_unit(hash_keys(10, i, 0, 0)) - 0.5),
+                                        3e4 * (to_unit(hash_keys(10, i, 1, 0)) - 0.5), to_unit(hash_keys(10, i, 2, 0)));
+    ASSERT_EQ(clouds->fields()[0]->sigma_t(p), expected.sigma_t(p));
+    ASSERT_EQ(timeless->fields()[0]->sigma_t(p), still.sigma_t(p));
+    differ += expected.sigma_t(p) != still.sigma_t(p);
+  }
+  EXPECT_GT(differ, 100);
 }
 
 TEST(CloudLayer, SameSpecSameBitsOtherSeedOtherField) {
