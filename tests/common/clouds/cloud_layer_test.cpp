@@ -297,6 +297,47 @@ TEST(CloudLayer, FramesAMinuteApartAreDifferentButCorrelated) {
   EXPECT_LT(corr, 0.999);
 }
 
+// The majorants in use: delta tracking's chance of passing a ray with no
+// collision, and ratio tracking's mean transmittance, both equal
+// exp(-tau) with tau integrated directly along the ray (1 m midpoint steps
+// over the shell, not using the majorants), within 4 standard errors.
+TEST(CloudLayer, TrackingThroughTheLayerIsUnbiased) {
+  CloudLayerSpec s = layer_spec(CloudType::kCumulus, 0.5);
+  s.optical_depth = 1.5;  // sigma_max ~ 1.7e-3 m^-1: rays through cores and gaps alike
+  auto layer = std::make_shared<CloudLayer>(s, kR, glm::dvec3(1e9, -3e8, 0.0));
+  const SceneClouds clouds({layer});
+  int checked = 0;
+  for (std::uint64_t r = 0; r < 24 && checked < 6; ++r) {
+    const Ray ray = random_ray(s, r % 2 == 0 ? 0 : 2, r);
+    const double t_end = 1e8;
+    const ShellIntervals shell = shell_intervals(ray, kR + s.base_m, kR + s.base_m + s.thickness_m, 0.0, t_end);
+    double tau = 0.0;
+    for (int k = 0; k < shell.count; ++k) {
+      const double a = shell.t0[static_cast<std::size_t>(k)], b = shell.t1[static_cast<std::size_t>(k)];
+      const int n = static_cast<int>(std::ceil(b - a));
+      for (int j = 0; j < n; ++j) tau += layer->sigma_t(ray.at(a + (j + 0.5) * (b - a) / n)) * (b - a) / n;
+    }
+    if (tau < 0.2 || tau > 3.0) continue;  // a ray with something to test, not hopeless
+    ++checked;
+    const double expected = std::exp(-tau);
+    const int n = 6000;
+    double sum = 0.0, sum2 = 0.0;
+    int passed = 0;
+    std::uint64_t collisions = 0;
+    for (int i = 0; i < n; ++i) {
+      Sampler a(21, r, static_cast<std::uint64_t>(i)), b(22, r, static_cast<std::uint64_t>(i));
+      passed += !clouds.sample_collision(ray, 0.0, t_end, a, &collisions).has_value();
+      const double T = clouds.transmittance(ray, 0.0, t_end, b, &collisions);
+      sum += T, sum2 += T * T;
+    }
+    const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+    const double p = static_cast<double>(passed) / n, p_se = std::sqrt(expected * (1.0 - expected) / n);
+    EXPECT_NEAR(mean, expected, 4.0 * se + 1e-6) << "ray " << r << " tau " << tau;
+    EXPECT_NEAR(p, expected, 4.0 * p_se) << "ray " << r << " tau " << tau;
+  }
+  EXPECT_EQ(checked, 6);
+}
+
 // The render setup drifts each layer by time since J2000 x its wind along
 // the observer's east (+x) and north (+y); a spec without a time does not.
 TEST(CloudLayer, TheRenderSetupDriftsLayersByTheWindSinceJ2000) {
