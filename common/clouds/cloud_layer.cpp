@@ -138,7 +138,8 @@ struct CloudLayer::Impl {
   // maximum over the box (its corners, value_noise.h), plus the margin for
   // points placed err_m off; the finer octaves only when the coarser ones
   // leave the cell possibly cloudy.
-  double cell_shape_bound(std::int64_t cx, std::int64_t cy, std::int64_t cz, double fbm_margin) const {
+  double cell_shape_bound(std::int64_t cx, std::int64_t cy, std::int64_t cz, double fbm_margin,
+                          std::array<ValueNoiseCell, kOctaves>& cache) const {
     const glm::dvec3 lo = glm::dvec3(static_cast<double>(cx), static_cast<double>(cy), static_cast<double>(cz)) /
                           static_cast<double>(kCellsPerScale);  // exact: a power of two
     const glm::dvec3 hi = lo + 1.0 / kCellsPerScale;
@@ -146,7 +147,7 @@ struct CloudLayer::Impl {
     for (int o = 0; o < kOctaves; ++o, frequency *= 2.0) {
       const auto i = static_cast<std::size_t>(o);
       rest -= kOctaveWeight[i];
-      known += kOctaveWeight[i] * value_noise_box_max(octave_seed[i], lo * frequency, hi * frequency);
+      known += kOctaveWeight[i] * value_noise_box_max(octave_seed[i], lo * frequency, hi * frequency, cache[i]);
       if (shape_of(known + std::max(0.0, rest)) == 0.0) return 0.0;
     }
     return shape_of(known);
@@ -233,6 +234,7 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
     }
   };
 
+  std::array<ValueNoiseCell, kOctaves> lattice_cache;  // neighbouring cells share lattice values
   const glm::dvec3 o = ray.o - m.drift;  // the ray in the noise's frame
   const glm::dvec3& d = ray.d;
   for (int s = 0; s < shell.count && !stopped; ++s) {
@@ -261,7 +263,7 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
       const auto i = static_cast<std::size_t>(axis);
       const double t_exit = std::min(t_next[i], b);
       if (t_exit > t) {
-        const double shape_bound = m.cell_shape_bound(cell[0], cell[1], cell[2], fbm_margin);
+        const double shape_bound = m.cell_shape_bound(cell[0], cell[1], cell[2], fbm_margin, lattice_cache);
         if (shape_bound > 0.0) cell_piece(t, t_exit, shape_bound);
         t = t_exit;
       }
