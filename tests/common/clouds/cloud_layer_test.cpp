@@ -19,6 +19,7 @@
 #include "common/core/constants.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/render/render_setup.h"
+#include "tests/support/cloud_slab_scene.h"
 #include "common/sampling/sampler.h"
 
 namespace skyfarm {
@@ -336,6 +337,43 @@ TEST(CloudLayer, TrackingThroughTheLayerIsUnbiased) {
     EXPECT_NEAR(p, expected, 4.0 * p_se) << "ray " << r << " tau " << tau;
   }
   EXPECT_EQ(checked, 6);
+}
+
+// Radiative transfer in a plane-parallel medium depends on the altitude only
+// through the optical depth (Chandrasekhar 1960, ch. I; Liou 2002, sec.
+// 6.1): an overcast layer (coverage 1, no erosion), whose extinction follows
+// its height profile, reflects as a uniform slab of the same vertical
+// optical depth and optics.  The path-traced reflectances of both agree
+// within 4 combined standard errors.  (The transmitted flux, and the
+// reflected one of thicker clouds, hold the Mie forward peak's spikes: their
+// standard errors at these sample counts are ~0.2, too large to test anything.)
+TEST(CloudLayer, AnOvercastLayerReflectsAsAUniformSlab) {
+  const double tau = 4.0, zenith = 40.0;
+  CloudLayerSpec s = layer_spec(CloudType::kStratus, 1.0);
+  s.erosion = 0.0;
+  s.optical_depth = tau;
+  s.base_m = testing::kSlabBottom_m;
+  s.thickness_m = testing::kSlabTop_m - testing::kSlabBottom_m;
+  const auto scene = [&](bool layered, double observer_altitude_m) {
+    auto sc = testing::cloud_slab_scene(tau, CloudOptics{}, zenith, observer_altitude_m);
+    const double radius = sc->atmosphere().planet_radius_m();
+    auto layer = std::make_shared<CloudLayer>(s, radius, glm::dvec3(0.0));
+    std::shared_ptr<const CloudField> field = layer;
+    if (!layered)
+      field = std::make_shared<UniformCloudSlab>(radius, s.base_m, s.base_m + s.thickness_m,
+                                                 tau / s.thickness_m, layer->optics());
+    sc->set_clouds(std::make_shared<SceneClouds>(std::vector<std::shared_ptr<const CloudField>>{field}));
+    return sc;
+  };
+  const int n = 12000;
+  const double altitude = s.base_m + s.thickness_m + 1.0;  // above, looking down
+  const testing::FluxEstimate layer = testing::hemisphere_flux_ratio(*scene(true, altitude), false, n, 31);
+  const testing::FluxEstimate slab = testing::hemisphere_flux_ratio(*scene(false, altitude), false, n, 32);
+  EXPECT_EQ(layer.counters.nonfinite, 0u);
+  const double se = std::hypot(layer.se, slab.se);
+  EXPECT_LT(se, 0.03);        // enough to tell tau 4 (R ~ 0.19) from tau 8 (R ~ 0.35)
+  EXPECT_GT(slab.mean, 0.1);
+  EXPECT_NEAR(layer.mean, slab.mean, 4.0 * se) << layer.mean << " vs " << slab.mean << ", se " << se;
 }
 
 // The render setup drifts each layer by time since J2000 x its wind along
