@@ -73,7 +73,8 @@ struct CloudLayer::Impl {
   CloudProfile profile;
   TiledWorleyNoise detail;
   std::array<std::uint64_t, kOctaves> octave_seed{};
-  double detail_spacing_m = 0.0;  // one table sample
+  double inv_scale = 0.0;           // 1 / scale_m
+  double inv_detail_spacing = 0.0;  // 1 / (one table sample, m)
   double coverage_lo = 0.0;       // the fBm where the remap's ramp starts
   bool empty = false;             // coverage 0 or sigma_max 0: no cloud at all
 
@@ -101,7 +102,8 @@ struct CloudLayer::Impl {
                                       : s.water_content_g_m3 * optics.extinction_per_g_m3;
     for (int o = 0; o < kOctaves; ++o)
       octave_seed[static_cast<std::size_t>(o)] = hash_keys(s.seed, kNoiseSalt, static_cast<std::uint64_t>(o), 0);
-    detail_spacing_m = s.detail_scale_m * TiledWorleyNoise::kCells / TiledWorleyNoise::kSize;
+    inv_scale = 1.0 / s.scale_m;
+    inv_detail_spacing = TiledWorleyNoise::kSize / (s.detail_scale_m * TiledWorleyNoise::kCells);
     coverage_lo = coverage_threshold(s.coverage);
     empty = s.coverage == 0.0 || !(sigma_max > 0.0);
   }
@@ -118,16 +120,22 @@ struct CloudLayer::Impl {
     const double prof = profile((h - spec.base_m) / spec.thickness_m);
     if (prof == 0.0) return 0.0;
     const glm::dvec3 q = p - drift;
-    const glm::dvec3 x = q / spec.scale_m;
-    double fbm = 0.0, frequency = 1.0;
-    for (int o = 0; o < kOctaves; ++o, frequency *= 2.0)
-      fbm += kOctaveWeight[static_cast<std::size_t>(o)] *
-             value_noise(octave_seed[static_cast<std::size_t>(o)], x * frequency);
+    const glm::dvec3 x = q * inv_scale;  // within an ulp of q / scale_m: the walk's margin covers it
+    // Octave by octave, stopping once even full values of the octaves left
+    // could not lift the fBm over the coverage threshold (clear air is the
+    // common case at low coverage).
+    double fbm = 0.0, frequency = 1.0, rest = 1.0;
+    for (int o = 0; o < kOctaves; ++o, frequency *= 2.0) {
+      const auto i = static_cast<std::size_t>(o);
+      fbm += kOctaveWeight[i] * value_noise(octave_seed[i], x * frequency);
+      rest -= kOctaveWeight[i];
+      if (fbm + rest <= coverage_lo) return 0.0;
+    }
     const double shape = shape_of(fbm);
     if (shape == 0.0) return 0.0;
     double d = shape * prof;
     if (spec.erosion > 0.0) {
-      const double a = std::min(kMaxErosion, spec.erosion * detail.lookup(q / detail_spacing_m));
+      const double a = std::min(kMaxErosion, spec.erosion * detail.lookup(q * inv_detail_spacing));
       d = std::min(d, std::max(0.0, (d - a) / (1.0 - a)));
     }
     return d;
