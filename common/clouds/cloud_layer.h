@@ -50,7 +50,8 @@
 // Parameters: CloudLayerSpec (cloud_spec.h); planet_radius_m, the ground's
 // radius; drift_m as above.  Throws std::invalid_argument for a spec out of
 // range (coverage or erosion outside [0, 1], a thickness, scale or detail
-// scale <= 0, a negative base, water content or optical depth).
+// scale <= 0, a negative base, water content or optical depth; and
+// cloud_optics' error for an effective radius outside its range).
 // Pure functions of the spec: the same bits on every worker.
 #pragma once
 #include <memory>
