@@ -20,7 +20,7 @@ std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objec
   return errors;
 }
 
-std::vector<api::FieldError> missing_assets(const CloudsSpec& clouds, const AssetStore* store) {
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store) {
   std::vector<api::FieldError> errors;
   for (std::size_t i = 0; i < clouds.volumes.size(); ++i) {
     const std::string& asset = clouds.volumes[i].asset;

@@ -18,6 +18,6 @@ class AssetStore;
 std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objects, const AssetStore* store);
 
 // Likewise for the cloud volumes' assets (clouds.volumes[i].asset).
-std::vector<api::FieldError> missing_assets(const CloudsSpec& clouds, const AssetStore* store);
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store);
 
 }  // namespace skyfarm::server

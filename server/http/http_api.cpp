@@ -393,7 +393,7 @@ void HttpApi::submit(const Request& req, Response& res, const ContentReader& rea
 // units (400 naming objects[i].asset or clouds.volumes[i].asset).
 void HttpApi::admit_objects(const api::RenderRequest& request) const {
   std::vector<api::FieldError> errors = missing_assets(api::render_spec(request).objects, options_.assets);
-  for (api::FieldError& e : missing_assets(request.clouds, options_.assets)) errors.push_back(std::move(e));
+  for (api::FieldError& e : missing_volume_assets(request.clouds, options_.assets)) errors.push_back(std::move(e));
   if (!errors.empty()) throw api::ValidationError(std::move(errors));
 }
 
