@@ -305,6 +305,23 @@ TEST(CloudFieldsCanonical, ClearSkyTextIsUnchanged) {
   }
 }
 
+// The canonical text of an example without clouds, byte for byte as the
+// parser wrote it before requests had clouds (its hash names cached results).
+TEST(CloudFieldsCanonical, ClearSkyExampleKeepsItsTextFromBeforeClouds) {
+  const std::string before =
+      R"({"atmosphere":{"aerosol":{"angstrom_exponent":1.3,"asymmetry":0.7,"optical_depth_550":0.1,)"
+      R"("phase":"henyey_greenstein","single_scattering_albedo":0.9},"ground_albedo":0.2,)"
+      R"("ozone_du":320.0,"planet_radius_m":6371000.0,"preset":"earth","top_altitude_m":100000.0},)"
+      R"("camera":{"fov_deg":180.0,"height":1024,"pitch_deg":90.0,"projection":"fisheye","roll_deg":0.0,)"
+      R"("width":1024,"yaw_deg":0.0},"location":{"altitude_m":35.0,"latitude_deg":48.8566,)"
+      R"("longitude_deg":2.3522},"method":"path","output":{"error_layer":true,"exposure_ev":null,)"
+      R"("half":true,"spectral_channels":false},"priority":50,"quality":{"samples_per_pixel":256,)"
+      R"("target_relative_error":null,"time_limit_s":null},"seed":1,"spectral":{"batches":1,)"
+      R"("max_nm":830.0,"min_nm":360.0},"sun":{"angular_radius_deg":0.2666,"azimuth_deg":null,)"
+      R"("irradiance":null,"zenith_deg":null},"time":"2021-06-21T11:50:00Z"})";
+  EXPECT_EQ(canonical_text(parse_render_request(read_text(kExamples / "noon_fisheye.json"))), before);
+}
+
 TEST(CloudFieldsCanonical, EveryFieldIsWrittenResolved) {
   const Json j = to_canonical_json(parse_render_request(body(
       R"({"layers": [{"type": "stratus", "optical_depth": 12}, {"type": "cirrus"}],
