@@ -18,9 +18,10 @@ constexpr Choice<CloudType> kCloudTypes[] = {{"cumulus", CloudType::kCumulus},
 constexpr Choice<CloudParticle> kParticles[] = {{"water", CloudParticle::kWater}, {"ice", CloudParticle::kIce}};
 constexpr std::size_t kMaxGridNameChars = 64;
 
-// Effective radii the optics tables cover: water droplets from haze-sized to
-// drizzle-sized (Miles et al. 2000 find cloud means of 2-20 um), ice crystals
-// from small quasi-spheres to large aggregates (Heymsfield & McFarquhar 2002).
+// Effective radii the optics take (common/clouds/cloud_optics.h): water, the
+// range of its Mie summary table, 0.5-25 um; ice, which geometric optics
+// would take at any size, from small quasi-spherical crystals to large
+// aggregates, 5-200 um, so that a typing slip (2000) is an error.
 Range radius_range(CloudParticle particle) {
   return particle == CloudParticle::kIce ? Range::closed(5, 200) : Range::closed(0.5, 25);
 }
