@@ -34,6 +34,14 @@ const Scene_ kScenes[] = {
     {"twilight96", R"("sun": {"zenith_deg": 96, "azimuth_deg": 180})"},
     {"orbit400km", R"("sun": {"zenith_deg": 45, "azimuth_deg": 180}, "location": {"altitude_m": 400000})"},
     {"haze", R"("sun": {"zenith_deg": 40, "azimuth_deg": 180}, "atmosphere": {"aerosol": {"optical_depth_550": 0.5}})"},
+    // A summer afternoon in Paris, clear and with scattered cumulus (the
+    // clouds' efficiency against the clear sky's).
+    {"paris_clear", R"("location": {"latitude_deg": 48.8566, "longitude_deg": 2.3522},)"
+                    R"( "time": "2026-07-15T17:00:00+02:00")"},
+    {"paris_cumulus", R"("location": {"latitude_deg": 48.8566, "longitude_deg": 2.3522},)"
+                      R"( "time": "2026-07-15T17:00:00+02:00", "clouds": {"layers": [{"type": "cumulus",)"
+                      R"( "coverage": 0.35, "base_m": 1400, "thickness_m": 1200, "seed": 7,)"
+                      R"( "wind": {"speed_m_s": 8, "from_deg": 270}}]})"},
 };
 
 std::string request_json(const Scene_& s, int spp, int seed) {
