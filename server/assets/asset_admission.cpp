@@ -11,11 +11,27 @@ std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objec
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const ObjectSpec& object = objects[i];
     if (object.shape != ShapeKind::kMesh) continue;
-    if (store != nullptr && store->meta(object.asset)) continue;
+    if (store != nullptr && store->meta(object.asset) && !store->is_volume(object.asset)) continue;
     errors.push_back({"objects[" + std::to_string(i) + "].asset",
                       store != nullptr ? "no such asset on this server; upload the mesh first (POST /v1/assets)"
                                        : "this server has no asset store",
                       "\"" + object.asset + "\""});
+  }
+  return errors;
+}
+
+std::vector<api::FieldError> missing_volume_assets(const std::vector<CloudVolumeSpec>& volumes,
+                                                   const AssetStore* store) {
+  std::vector<api::FieldError> errors;
+  for (std::size_t i = 0; i < volumes.size(); ++i) {
+    const CloudVolumeSpec& volume = volumes[i];
+    if (store != nullptr && store->is_volume(volume.asset)) continue;
+    errors.push_back({"clouds.volumes[" + std::to_string(i) + "].asset",
+                      store == nullptr          ? "this server has no asset store"
+                      : store->meta(volume.asset) ? "this asset is a mesh, not a cloud volume"
+                                                  : "no such asset on this server; upload the OpenVDB file first "
+                                                    "(POST /v1/assets)",
+                      "\"" + volume.asset + "\""});
   }
   return errors;
 }

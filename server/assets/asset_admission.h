@@ -1,4 +1,5 @@
-// Admission of a request whose objects name mesh assets: every asset must be
+// Admission of a request whose objects name mesh assets (or whose clouds
+// name volume assets): every asset must be
 // in the server's store before a job is made of it, or no worker could
 // render it.  The errors name the field, as the request parser's do:
 //   objects[2].asset: no such asset on this server; upload the mesh (POST /v1/assets), got "sha256:..."
@@ -6,6 +7,7 @@
 #include <vector>
 
 #include "api/field_error.h"
+#include "common/clouds/cloud_spec.h"
 #include "common/objects/object_spec.h"
 
 namespace skyfarm::server {
@@ -15,5 +17,9 @@ class AssetStore;
 // The errors for mesh objects whose asset `store` lacks (all of them when
 // there is no store); empty when the request may be admitted.
 std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objects, const AssetStore* store);
+
+// The same for cloud volumes: clouds.volumes[i].asset must be a stored volume.
+std::vector<api::FieldError> missing_volume_assets(const std::vector<CloudVolumeSpec>& volumes,
+                                                   const AssetStore* store);
 
 }  // namespace skyfarm::server
