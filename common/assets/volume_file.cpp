@@ -29,6 +29,9 @@ T read_at(std::string_view bytes, std::size_t offset) {
 
 std::string volume_size_error(std::uint64_t nx, std::uint64_t ny, std::uint64_t nz, const VolumeLimits& limits) {
   if (nx == 0 || ny == 0 || nz == 0) return "the volume has no voxels";
+  // Indices are ints (VolumeGrid::size): no axis beyond 2^31 - 1, whatever the limits.
+  constexpr std::uint64_t kMaxAxis = 0x7fffffff;
+  if (nx > kMaxAxis || ny > kMaxAxis || nz > kMaxAxis) return "the volume has more than 2^31 - 1 voxels along an axis";
   // Each count is < 2^32, so the product of two fits; the third is checked by division.
   const std::uint64_t nxy = nx * ny;
   const std::string dims = std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz);
@@ -65,7 +68,7 @@ bool decode_volume_file(std::string_view bytes, const VolumeLimits& limits, Volu
   const std::uint64_t nx = read_at<std::uint32_t>(bytes, 8), ny = read_at<std::uint32_t>(bytes, 12),
                       nz = read_at<std::uint32_t>(bytes, 16);
   if (std::string why = volume_size_error(nx, ny, nz, limits); !why.empty()) return fail(why);
-  // The counts are within limits (<= 2^31 voxels), so the int sizes and the byte count hold.
+  // Each count fits an int, and their product is within the limits.
   const std::uint64_t count = nx * ny * nz;
   if (bytes.size() != kVolumeFileHeaderBytes + 4 * count) return fail("volume file size does not match its counts");
   VolumeGrid g;

@@ -62,10 +62,12 @@ TEST(VolumeFile, RejectsCorruptFiles) {
   poke<std::uint32_t>(zero, 12, 0);
   EXPECT_NE(refusal(zero).find("no voxels"), std::string::npos);
   std::string huge = good;
-  poke<std::uint32_t>(huge, 8, 0xffffffffu);
-  poke<std::uint32_t>(huge, 12, 0xffffffffu);
-  poke<std::uint32_t>(huge, 16, 0xffffffffu);
+  poke<std::uint32_t>(huge, 8, 0x10000u);
+  poke<std::uint32_t>(huge, 12, 0x10000u);
+  poke<std::uint32_t>(huge, 16, 0x10000u);
   EXPECT_NE(refusal(huge).find("more than the limit"), std::string::npos);
+  poke<std::uint32_t>(huge, 8, 0xffffffffu);
+  EXPECT_NE(refusal(huge).find("along an axis"), std::string::npos);
   VolumeLimits tight;
   tight.max_voxels = 23;
   EXPECT_NE(refusal(good, tight).find("more than the limit of 23"), std::string::npos);
