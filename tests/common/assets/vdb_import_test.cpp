@@ -78,6 +78,21 @@ TEST(VdbImport, DenseActiveBoxInMetres) {
   }
 }
 
+// The example asset, written by Debian's pyopenvdb (scripts/make-example-cloud.py):
+// its active box and its transform (25 m voxels, centred in x and y).
+TEST(VdbImport, TheExampleCloudReads) {
+  std::ifstream in(std::filesystem::path(SKYFARM_SOURCE_DIR) / "api/examples/assets/cumulus.vdb", std::ios::binary);
+  std::stringstream bytes;
+  bytes << in.rdbuf();
+  VolumeGrid g;
+  std::string error;
+  ASSERT_TRUE(import_vdb(bytes.str(), "density", {}, &g, &error)) << error;
+  EXPECT_EQ(g.voxel_size_m, glm::dvec3(25.0));
+  EXPECT_EQ(g.size, glm::ivec3(32, 27, 24));  // index box (8, 10, 3)-(39, 36, 26) of 48 x 48 x 32
+  EXPECT_EQ(g.origin_m, glm::dvec3(8 * 25.0 - 587.5, 10 * 25.0 - 587.5, 3 * 25.0));
+  EXPECT_EQ(g.max_value, 1.0f);
+}
+
 TEST(VdbImport, ClampsValuesToFiniteNonNegative) {
   openvdb::initialize();
   auto grid = openvdb::FloatGrid::create(0.0f);
