@@ -11,7 +11,7 @@ set(SKYFARM_DATA_FILES
   us_std_atm_1976_layers.csv
   elterman_1968_aerosol.csv
   rayleigh_bucholtz1995.csv
-  cloud_mie_phase_water_reff10um.csv
+  cloud_mie_phase_water_reff10um.csv cloud_mie_water_summary.csv
   spa_periodic_terms.csv spa_nutation_terms.csv
   # Surfaces: optical constants and ground albedos (common/material/material_library.cpp).
   metal_nk_au_johnson_christy1972.csv metal_nk_ag_johnson_christy1972.csv

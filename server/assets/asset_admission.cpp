@@ -20,18 +20,16 @@ std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objec
   return errors;
 }
 
-std::vector<api::FieldError> missing_volume_assets(const std::vector<CloudVolumeSpec>& volumes,
-                                                   const AssetStore* store) {
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store) {
   std::vector<api::FieldError> errors;
-  for (std::size_t i = 0; i < volumes.size(); ++i) {
-    const CloudVolumeSpec& volume = volumes[i];
-    if (store != nullptr && store->is_volume(volume.asset)) continue;
+  for (std::size_t i = 0; i < clouds.volumes.size(); ++i) {
+    const std::string& asset = clouds.volumes[i].asset;
+    if (store != nullptr && store->is_volume(asset)) continue;
     errors.push_back({"clouds.volumes[" + std::to_string(i) + "].asset",
-                      store == nullptr          ? "this server has no asset store"
-                      : store->meta(volume.asset) ? "this asset is a mesh, not a cloud volume"
-                                                  : "no such asset on this server; upload the OpenVDB file first "
-                                                    "(POST /v1/assets)",
-                      "\"" + volume.asset + "\""});
+                      store == nullptr    ? "this server has no asset store"
+                      : store->meta(asset) ? "this asset is a mesh, not a cloud volume"
+                                           : "no such asset on this server; upload the volume first (POST /v1/assets)",
+                      "\"" + asset + "\""});
   }
   return errors;
 }

@@ -18,8 +18,8 @@ class AssetStore;
 // there is no store); empty when the request may be admitted.
 std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objects, const AssetStore* store);
 
-// The same for cloud volumes: clouds.volumes[i].asset must be a stored volume.
-std::vector<api::FieldError> missing_volume_assets(const std::vector<CloudVolumeSpec>& volumes,
-                                                   const AssetStore* store);
+// Likewise for the cloud volumes' assets (clouds.volumes[i].asset), which
+// must be stored volumes, not meshes.
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store);
 
 }  // namespace skyfarm::server

@@ -130,15 +130,16 @@ TEST_F(VolumeUploadTest, UploadGetAndReupload) {
   expect_problem(c.Get(("/v1/assets/" + id + "/mesh").c_str()), 404);
 
   // Admission: a request's clouds.volumes naming it pass, a mesh or an unknown id does not.
-  CloudVolumeSpec spec;
-  spec.asset = id;
-  EXPECT_TRUE(missing_volume_assets({spec}, store_.get()).empty());
+  CloudsSpec clouds;
+  clouds.volumes.resize(1);
+  clouds.volumes[0].asset = id;
+  EXPECT_TRUE(missing_volume_assets(clouds, store_.get()).empty());
   ObjectSpec object;
   object.shape = ShapeKind::kMesh;
   object.asset = id;
   EXPECT_EQ(missing_assets({object}, store_.get()).size(), 1u) << "a volume is not a mesh";
-  spec.asset = "sha256:" + std::string(64, 'b');
-  const auto errors = missing_volume_assets({spec}, store_.get());
+  clouds.volumes[0].asset = "sha256:" + std::string(64, 'b');
+  const auto errors = missing_volume_assets(clouds, store_.get());
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0].path, "clouds.volumes[0].asset");
 }
