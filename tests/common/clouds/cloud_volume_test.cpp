@@ -13,7 +13,9 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "common/assets/volume_source.h"
 #include "common/clouds/scene_clouds.h"
+#include "common/render/render_setup.h"
 #include "common/sampling/sampler.h"
 
 namespace skyfarm {
@@ -225,6 +227,57 @@ TEST(CloudVolume, RatioTrackingMatchesBeerLambert) {
   }
   const double mean = sum / n, sd = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
   EXPECT_NEAR(mean, std::exp(-tau), 4.0 * sd + 1e-4) << "tau " << tau << ", sd " << sd;
+}
+
+// A request's volume (RenderSpec::clouds) becomes a CloudVolume: the grid
+// from the source, placed, scaled, with the particles' optics.
+class OneGridSource : public assets::VolumeSource {
+ public:
+  explicit OneGridSource(std::shared_ptr<const assets::VolumeGrid> grid) : grid_(std::move(grid)) {}
+  std::shared_ptr<const assets::VolumeGrid> volume(std::string_view id) const override {
+    if (id != "sha256:" + std::string(64, 'a')) throw std::runtime_error("asset " + std::string(id) + " is unknown");
+    return grid_;
+  }
+
+ private:
+  std::shared_ptr<const assets::VolumeGrid> grid_;
+};
+
+TEST(CloudVolume, MakeSceneCloudsPlacesTheRequestsVolumes) {
+  auto grid = std::make_shared<assets::VolumeGrid>();
+  grid->size = {4, 4, 8};
+  grid->voxel_size_m = glm::dvec3(25.0);
+  grid->origin_m = {-37.5, -37.5, 0.0};
+  grid->values.assign(4 * 4 * 8, 0.5f);
+  grid->max_value = 0.5f;
+  const OneGridSource source(grid);
+  RenderSpec spec;
+  CloudVolumeSpec v;
+  v.asset = "sha256:" + std::string(64, 'a');
+  v.placement.translate_m = {0.0, 1000.0, 1500.0};
+  v.density_scale = 0.02;
+  v.effective_radius_um = 10.0;
+  spec.clouds.volumes.push_back(v);
+  const auto clouds = make_scene_clouds(spec, kRadius, &source);
+  ASSERT_TRUE(clouds);
+  ASSERT_EQ(clouds->fields().size(), 1u);
+  EXPECT_EQ(clouds->fields()[0]->optics().albedo, cloud_optics(CloudParticle::kWater, 10.0).albedo);
+  // Straight up through its middle (x = y = 0 lies between the 2nd and 3rd
+  // voxel centres, where the field is still the full 0.5): tau = 0.02 * 0.5 * 8 * 25 m.
+  const EnuFrame enu(kRadius);
+  const Ray up{enu.to_world({0.0, 1000.0, 1000.0}), {0.0, 0.0, 1.0}};
+  EXPECT_NEAR(clouds->optical_depth(up, 0.0, 2000.0, 0.5), 0.02 * 0.5 * 8 * 25.0, 1e-6);
+  EXPECT_LE(clouds->bottom_altitude_m(), 1500.0 - 25.0);
+  EXPECT_GE(clouds->top_altitude_m(), 1500.0 + 8 * 25.0);
+
+  EXPECT_THROW(make_scene_clouds(spec, kRadius, nullptr), std::runtime_error);
+  spec.clouds.volumes[0].asset = "sha256:" + std::string(64, 'b');
+  try {
+    (void)make_scene_clouds(spec, kRadius, &source);
+    ADD_FAILURE() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("is unknown"), std::string::npos) << e.what();
+  }
 }
 
 TEST(CloudVolume, RejectsBadArguments) {
