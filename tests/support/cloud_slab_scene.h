@@ -57,7 +57,8 @@ inline FluxEstimate hemisphere_flux_ratio(const Scene& scene, bool looking_up, i
   SampledWavelengths wl;
   wl.lambda_nm.fill(kSlabLambda_nm);
   wl.pdf.fill(1.0);
-  const double mu0 = scene.sun().direction().z;
+  // (|mu0|: a sun below the horizon still gives a positive ratio.)
+  const double mu0 = std::abs(scene.sun().direction().z);
   const double norm = 3.14159265358979323846 / (mu0 * scene.sun().irradiance(kSlabLambda_nm));
   FluxEstimate out;
   double sum = 0.0, sum2 = 0.0;

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/clouds/cloud_layer.h"
 #include "common/core/constants.h"
 #include "tests/support/cloud_slab_scene.h"
 
@@ -83,13 +84,25 @@ TEST(CloudExtremes, CameraInsideACloudSeesFog) {
   EXPECT_GT(up.flux.mean, down.flux.mean);
 }
 
-// A cloud at 8.5-9.5 km after sunset, the sun 2.5 deg below the horizon:
-// the planet's shadow covers the ground observer but not the cloud, which
-// the sun lights from beneath.  The base seen from the ground is bright.
-TEST(CloudExtremes, SunBelowTheHorizonLightsACloudFromBeneath) {
-  const auto scene = testing::cloud_slab_scene(5.0, hg_cloud(0.85), 92.5, 0.0, 8500.0, 9500.0);
-  const Cost up = measure(*scene, true, 4000, 25);
-  std::printf("cloud lit from beneath: %.4f +- %.4f of mu0 E0 (%.1f collisions/path)\n", up.flux.mean, up.flux.se,
+// A broken cloud layer at 8.5-9.5 km after sunset, the sun 2.5 deg below
+// the horizon: the planet's shadow covers the ground observer but not the
+// clouds, which the sun lights from beneath through their gaps (a uniform
+// shell could not be: the sun's ray from its base crosses the shell again
+// far away).  The sky seen from the ground is lit.
+TEST(CloudExtremes, SunBelowTheHorizonLightsCloudsFromBeneath) {
+  auto scene = std::make_unique<Scene>(Scene::from_specs(testing::thin_hg_layer(1e-15, 10500.0, 0.0),
+                                                         testing::sun_spec(92.5, 0.0, 0.0), Location{}, std::nullopt,
+                                                         500.0, 600.0));
+  CloudLayerSpec layer = cloud_layer_preset(CloudType::kCumulus);
+  layer.base_m = 8500.0;
+  layer.thickness_m = 1000.0;
+  layer.coverage = 0.4;
+  layer.optical_depth = 5.0;
+  const double R = scene->atmosphere().planet_radius_m();
+  scene->set_clouds(std::make_shared<SceneClouds>(
+      std::vector<std::shared_ptr<const CloudField>>{std::make_shared<CloudLayer>(layer, R, glm::dvec3(0.0))}));
+  const Cost up = measure(*scene, true, 40000, 25);
+  std::printf("clouds lit from beneath: %.5f +- %.5f of mu0 E0 (%.1f collisions/path)\n", up.flux.mean, up.flux.se,
               up.collisions_per_path);
   expect_sane(up, 2000.0);
   EXPECT_GT(up.flux.mean, 4.0 * up.flux.se);
