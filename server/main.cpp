@@ -23,6 +23,7 @@
 #include "server/timelapse/timelapse_service.h"
 #include "server/assets/asset_store.h"
 #include "server/assets/mesh_import_process.h"
+#include "server/assets/volume_import_process.h"
 
 namespace {
 
@@ -101,6 +102,9 @@ int main(int argc, char** argv) {
     return skyfarm::api::run_keygen_command("skyfarm-server", {argv + 2, argv + argc});
   // The mesh import's child process (server/assets/mesh_import_process.h), run by this server.
   if (argc >= 2 && std::string(argv[1]) == "import-mesh") return run_import_mesh_command({argv + 2, argv + argc});
+  // The OpenVDB import's child process (server/assets/volume_import_process.h).
+  if (argc >= 2 && std::string(argv[1]) == "import-volume")
+    return run_import_volume_command({argv + 2, argv + argc});
   ServerOptions options;
   if (const std::string err = parse_server_options({argv + 1, argv + argc}, &options); !err.empty()) {
     std::cerr << "skyfarm-server: " << err << "\n" << kServerUsage;
@@ -157,11 +161,12 @@ int main(int argc, char** argv) {
 
     AssetStoreOptions asset_options;
     asset_options.import.command = {"/proc/self/exe", "import-mesh"};
+    asset_options.volume_import.command = {"/proc/self/exe", "import-volume"};
     AssetStore assets(options.data_dir, asset_options);
 
     BrokerOptions broker_options;
-    // Workers fetch the mesh assets their units name (ASSET_GET, api/wire.h).
-    broker_options.asset_file = [&assets](const std::string& id) { return assets.mesh_file(id); };
+    // Workers fetch the mesh and volume assets their units name (ASSET_GET, api/wire.h).
+    broker_options.asset_file = [&assets](const std::string& id) { return assets.asset_file(id); };
     broker_options.endpoint = options.broker;
     broker_options.curve_secret_key = credentials.server.secret_key;
     broker_options.auth.allowed_keys = credentials.allowed_keys;

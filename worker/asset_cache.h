@@ -1,7 +1,10 @@
 // A worker's disk cache of mesh assets: <dir>/<hex>.mesh, the canonical mesh
 // file (common/assets/mesh_file.h) of the asset "sha256:<hex>", so a worker
 // that restarts, or a second worker on the same machine, does not fetch it
-// again.  `skyfarm-worker render` looks there too.
+// again.  `skyfarm-worker render` looks there too.  A cloud volume's SKYVOL1
+// file (common/assets/volume_file.h) is kept under the same name: the id
+// names the bytes, whichever kind they are, and the caches that read them
+// (mesh_cache.h, volume_cache.h) check both the hash and the format.
 //
 // Parameters
 //   dir        the folder (created on the first write); the farm worker's

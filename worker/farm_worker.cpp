@@ -29,6 +29,7 @@
 #include "worker/asset_cache.h"
 #include "worker/asset_requests.h"
 #include "worker/mesh_cache.h"
+#include "worker/volume_cache.h"
 #include "worker/probe_unit.h"
 #include "worker/setup_cache.h"
 
@@ -48,11 +49,12 @@ struct JobRenderer {
   std::unique_ptr<TileRenderer> renderer;
 };
 
-JobRenderer make_job_renderer(const std::string& request_text, const assets::MeshSource* meshes) {
+JobRenderer make_job_renderer(const std::string& request_text, const assets::MeshSource* meshes,
+                              const assets::VolumeSource* volumes) {
   try {
     const api::RenderRequest request = api::parse_render_request(request_text);
     JobRenderer job;
-    job.setup = make_render_setup(api::render_spec(request), meshes);
+    job.setup = make_render_setup(api::render_spec(request), meshes, volumes);
     job.renderer = std::make_unique<TileRenderer>(*job.setup.scene, *job.setup.camera, job.setup.plan);
     return job;
   } catch (const api::ValidationError& ex) {
@@ -66,8 +68,9 @@ JobRenderer make_job_renderer(const std::string& request_text, const assets::Mes
 
 // The setups of render jobs and of probes, each an LRU of setup_cache_jobs.
 struct Setups {
-  Setups(std::size_t jobs, const assets::MeshSource* meshes)
-      : renders(jobs, [meshes](const std::string& request) { return make_job_renderer(request, meshes); }),
+  Setups(std::size_t jobs, const assets::MeshSource* meshes, const assets::VolumeSource* volumes)
+      : renders(jobs,
+                [meshes, volumes](const std::string& request) { return make_job_renderer(request, meshes, volumes); }),
         probes(jobs, make_probe_setup) {}
   SetupCache<JobRenderer> renders;
   SetupCache<ProbeSetup> probes;
@@ -125,8 +128,9 @@ api::Message render_unit_message(Setups& setups, const api::UnitMsg& task) {
 // for the I/O thread, which is woken through the pipe.
 class RenderPool {
  public:
-  RenderPool(int threads, std::size_t cache_jobs, const assets::MeshSource* meshes, const WakeupPipe& wakeup)
-      : setups_(cache_jobs, meshes), wakeup_(wakeup) {
+  RenderPool(int threads, std::size_t cache_jobs, const assets::MeshSource* meshes,
+             const assets::VolumeSource* volumes, const WakeupPipe& wakeup)
+      : setups_(cache_jobs, meshes, volumes), wakeup_(wakeup) {
     for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { work(); });
   }
   ~RenderPool() { stop(); }
@@ -231,6 +235,7 @@ struct FarmWorker::Impl {
   AssetRequests asset_requests{[this] { wakeup.notify(); }};
   std::unique_ptr<AssetDiskCache> asset_disk;
   std::unique_ptr<MeshCache> meshes;
+  std::unique_ptr<VolumeCache> volumes;  // fetched as meshes are (ASSET_GET), SKYVOL1 files
 
  private:
   // --- sessions
@@ -277,12 +282,14 @@ FarmWorker::Impl::Impl(FarmWorkerOptions o) : options(std::move(o)) {
     asset_disk = std::make_unique<AssetDiskCache>(options.asset_cache_dir, options.asset_cache_bytes);
   meshes = std::make_unique<MeshCache>(
       asset_disk.get(), [this](const std::string& id) { return fetch_asset(id); }, options.asset_memory_bytes);
+  volumes = std::make_unique<VolumeCache>(
+      asset_disk.get(), [this](const std::string& id) { return fetch_asset(id); }, options.asset_memory_bytes);
 }
 
 int FarmWorker::Impl::run() {
   if (running.exchange(true)) throw std::logic_error("FarmWorker::run called twice");
   pool_ = std::make_unique<RenderPool>(threads, static_cast<std::size_t>(options.setup_cache_jobs), meshes.get(),
-                                       wakeup);
+                                       volumes.get(), wakeup);
   log("worker " + options.id + ": " + std::to_string(threads) + " render threads, " + std::to_string(slots) +
       " slots, server " + options.endpoint);
   zmq::context_t ctx(1);

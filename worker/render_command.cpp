@@ -74,9 +74,9 @@ std::string parse_render_args(const std::vector<std::string>& args, RenderArgs* 
 
 int render_to_files(const api::RenderRequest& request, const std::string& exr_path, const std::string& png_path,
                     int threads, const std::string& label, int png_bits = 8,
-                    const assets::MeshSource* meshes = nullptr) {
+                    const assets::MeshSource* meshes = nullptr, const assets::VolumeSource* volumes = nullptr) {
   const auto t0 = std::chrono::steady_clock::now();
-  const RenderSetup setup = make_render_setup(api::render_spec(request), meshes);
+  const RenderSetup setup = make_render_setup(api::render_spec(request), meshes, volumes);
   const Scene& scene = *setup.scene;
   const RenderPlan& plan = setup.plan;
   const TileRenderer renderer(scene, *setup.camera, plan);
@@ -156,11 +156,12 @@ int run_render_command(const std::vector<std::string>& args) {
     return 1;
   }
   try {
-    // Mesh files named by path become asset ids before the request is parsed (request_assets.h).
+    // Mesh and volume files named by path become asset ids before the request is parsed (request_assets.h).
     std::unique_ptr<AssetDiskCache> disk;  // read only: the farm worker's cache
     std::unique_ptr<LocalMeshSource> meshes;
+    std::unique_ptr<LocalVolumeSource> volumes;
     nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-    if (json.is_object() && json.contains("objects")) {
+    if (json.is_object() && (json.contains("objects") || json.contains("clouds"))) {
       const char* env_cache = std::getenv("SKYFARM_ASSET_CACHE");
       disk = std::make_unique<AssetDiskCache>(!a.asset_cache.empty() ? a.asset_cache
                                               : env_cache != nullptr && *env_cache != '\0'
@@ -170,10 +171,11 @@ int run_render_command(const std::vector<std::string>& args) {
       const std::filesystem::path base =
           a.request == "-" ? std::filesystem::current_path() : std::filesystem::path(a.request).parent_path();
       meshes = resolve_request_assets(&json, base.string(), disk.get());
+      volumes = resolve_request_volumes(&json, base.string(), disk.get());
       text = json.dump();
     }
     const api::RenderRequest request = api::parse_render_request(text);
-    return render_to_files(request, a.exr, a.png, a.threads, "render", a.png_bits, meshes.get());
+    return render_to_files(request, a.exr, a.png, a.threads, "render", a.png_bits, meshes.get(), volumes.get());
   } catch (const api::ValidationError& e) {
     std::cerr << a.request << ": invalid request\n" << e.what() << "\n";
     return 2;

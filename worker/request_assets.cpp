@@ -11,6 +11,8 @@
 #include "common/assets/asset_id.h"
 #include "common/assets/mesh_file.h"
 #include "common/assets/mesh_import.h"
+#include "common/assets/vdb_import.h"
+#include "common/assets/volume_file.h"
 
 namespace skyfarm {
 
@@ -49,7 +51,88 @@ std::string import_file(const fs::path& path, const std::string& shown, std::str
   return "";
 }
 
+// The imported volume file's id and grid, or an error sentence.
+std::string import_volume_file(const fs::path& path, const std::string& shown, const std::string& grid_name,
+                               std::string* id, std::shared_ptr<const assets::VolumeGrid>* out) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    const bool exists = fs::exists(path, ec);
+    return "cannot read " + shown + ": " + (exists ? "permission denied or not a file" : "no such file");
+  }
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) return "cannot read " + shown + ": read error";
+  auto grid = std::make_shared<assets::VolumeGrid>();
+  std::string error;
+  if (assets::is_volume_file(bytes)) {
+    if (!assets::decode_volume_file(bytes, assets::VolumeLimits{}, grid.get(), &error))
+      return "cannot read " + shown + ": " + error;
+  } else if (assets::looks_like_vdb(bytes)) {
+    if (!assets::import_vdb(bytes, grid_name, assets::VolumeLimits{}, grid.get(), &error))
+      return "cannot import " + shown + ": " + error;
+  } else {
+    return "cannot import " + shown + ": not an OpenVDB (.vdb) or SKYVOL1 file";
+  }
+  *id = assets::asset_id_of(assets::encode_volume_file(*grid));
+  *out = std::move(grid);
+  return "";
+}
+
 }  // namespace
+
+std::shared_ptr<const assets::VolumeGrid> LocalVolumeSource::volume(std::string_view id) const {
+  if (const auto it = imported_.find(id); it != imported_.end()) return it->second;
+  return cache_.volume(id);
+}
+
+std::unique_ptr<LocalVolumeSource> resolve_request_volumes(nlohmann::json* request, const std::string& base_dir,
+                                                           AssetDiskCache* disk) {
+  auto source = std::make_unique<LocalVolumeSource>(disk);
+  if (!request->is_object()) return source;
+  const auto clouds = request->find("clouds");
+  if (clouds == request->end() || !clouds->is_object()) return source;
+  const auto volumes = clouds->find("volumes");
+  if (volumes == clouds->end() || !volumes->is_array()) return source;
+  std::vector<api::FieldError> errors;
+  std::map<std::string, std::string> imported;  // path and grid -> id: a file named twice is read once
+  for (std::size_t i = 0; i < volumes->size(); ++i) {
+    nlohmann::json& volume = (*volumes)[i];
+    if (!volume.is_object()) continue;
+    const auto asset = volume.find("asset");
+    if (asset == volume.end() || !asset->is_string()) continue;
+    const std::string field = "clouds.volumes[" + std::to_string(i) + "].asset";
+    const std::string value = asset->get<std::string>();
+    if (assets::is_asset_id(value)) {
+      try {
+        (void)source->volume(value);  // loads it now, so a missing one is named by its field
+      } catch (const std::exception& e) {
+        errors.push_back({field, e.what(), ""});
+      }
+      continue;
+    }
+    if (value.empty()) continue;  // the parser says what an asset must be
+    const auto grid_field = volume.find("grid");
+    const std::string grid =
+        grid_field != volume.end() && grid_field->is_string() ? grid_field->get<std::string>() : std::string();
+    const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
+    const std::string key = path.string() + '\n' + grid;
+    std::string id;
+    if (const auto seen = imported.find(key); seen != imported.end()) {
+      id = seen->second;
+    } else {
+      std::shared_ptr<const assets::VolumeGrid> loaded;
+      if (std::string error = import_volume_file(path, value, grid, &id, &loaded); !error.empty()) {
+        errors.push_back({field, error, ""});
+        continue;
+      }
+      source->add(id, std::move(loaded));
+      imported.emplace(key, id);
+    }
+    *asset = id;
+  }
+  if (!errors.empty()) throw api::ValidationError(std::move(errors));
+  return source;
+}
 
 std::shared_ptr<const assets::TriangleMesh> LocalMeshSource::mesh(std::string_view id) const {
   if (const auto it = imported_.find(id); it != imported_.end()) return it->second;

@@ -11,7 +11,7 @@ std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objec
   for (std::size_t i = 0; i < objects.size(); ++i) {
     const ObjectSpec& object = objects[i];
     if (object.shape != ShapeKind::kMesh) continue;
-    if (store != nullptr && store->meta(object.asset)) continue;
+    if (store != nullptr && store->meta(object.asset) && !store->is_volume(object.asset)) continue;
     errors.push_back({"objects[" + std::to_string(i) + "].asset",
                       store != nullptr ? "no such asset on this server; upload the mesh first (POST /v1/assets)"
                                        : "this server has no asset store",
@@ -24,10 +24,11 @@ std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, con
   std::vector<api::FieldError> errors;
   for (std::size_t i = 0; i < clouds.volumes.size(); ++i) {
     const std::string& asset = clouds.volumes[i].asset;
-    if (store != nullptr && store->meta(asset)) continue;
+    if (store != nullptr && store->is_volume(asset)) continue;
     errors.push_back({"clouds.volumes[" + std::to_string(i) + "].asset",
-                      store != nullptr ? "no such asset on this server; upload the volume first (POST /v1/assets)"
-                                       : "this server has no asset store",
+                      store == nullptr    ? "this server has no asset store"
+                      : store->meta(asset) ? "this asset is a mesh, not a cloud volume"
+                                           : "no such asset on this server; upload the volume first (POST /v1/assets)",
                       "\"" + asset + "\""});
   }
   return errors;

@@ -1,4 +1,5 @@
-// Admission of a request whose objects name mesh assets: every asset must be
+// Admission of a request whose objects name mesh assets (or whose clouds
+// name volume assets): every asset must be
 // in the server's store before a job is made of it, or no worker could
 // render it.  The errors name the field, as the request parser's do:
 //   objects[2].asset: no such asset on this server; upload the mesh (POST /v1/assets), got "sha256:..."
@@ -17,7 +18,8 @@ class AssetStore;
 // there is no store); empty when the request may be admitted.
 std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objects, const AssetStore* store);
 
-// Likewise for the cloud volumes' assets (clouds.volumes[i].asset).
+// Likewise for the cloud volumes' assets (clouds.volumes[i].asset), which
+// must be stored volumes, not meshes.
 std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store);
 
 }  // namespace skyfarm::server

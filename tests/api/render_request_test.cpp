@@ -7,6 +7,8 @@
 
 #include "common/assets/mesh_file.h"
 #include "common/assets/mesh_import.h"
+#include "common/assets/vdb_import.h"
+#include "common/assets/volume_file.h"
 #include "server/assets/asset_store.h"
 #include "tests/support/test_files.h"
 
@@ -47,7 +49,22 @@ std::vector<fs::path> json_files(const fs::path& dir, bool probes) {
 // failure here, not a skip.
 std::string with_asset_ids(const fs::path& file) {
   nlohmann::json body = nlohmann::json::parse(read_text(file));
-  if (!body.is_object() || !body.contains("objects") || !body["objects"].is_array()) return read_text(file);
+  if (!body.is_object() || (!body.contains("objects") && !body.contains("clouds"))) return read_text(file);
+  // Cloud volumes likewise: the SHA-256 of the SKYVOL1 file the server's OpenVDB import writes.
+  if (body.contains("clouds") && body["clouds"].is_object() && body["clouds"].contains("volumes"))
+    for (auto& volume : body["clouds"]["volumes"]) {
+      if (!volume.is_object() || !volume.contains("asset") || !volume["asset"].is_string()) continue;
+      const std::string asset = volume["asset"].get<std::string>();
+      if (server::is_asset_id(asset)) continue;
+      const fs::path volume_file = file.parent_path() / asset;
+      assets::VolumeGrid grid;
+      std::string error;
+      EXPECT_TRUE(fs::exists(volume_file)) << volume_file;
+      EXPECT_TRUE(assets::import_vdb(read_text(volume_file), volume.value("grid", ""), {}, &grid, &error))
+          << volume_file << ": " << error;
+      volume["asset"] = "sha256:" + server::sha256_hex(assets::encode_volume_file(grid));
+    }
+  if (!body.contains("objects") || !body["objects"].is_array()) return body.dump();
   for (auto& object : body["objects"]) {
     if (!object.is_object() || !object.contains("asset") || !object["asset"].is_string()) continue;
     const std::string asset = object["asset"].get<std::string>();

@@ -58,9 +58,13 @@ TEST(AssetAdmission, CloudVolumesMustBeInTheStore) {
   AssetStore store(dir.string(), {});
   const std::string hex = assets::sha256_hex("volume");
   const std::string stored = "sha256:" + hex;
-  std::ofstream(dir / "assets" / (hex + ".mesh")) << "volume";
-  std::ofstream(dir / "assets" / (hex + ".json")) << R"({"id": ")" << stored << R"("})";
-  ASSERT_TRUE(store.meta(stored));
+  std::ofstream(dir / "assets" / (hex + ".vol")) << "volume";
+  std::ofstream(dir / "assets" / (hex + ".json")) << R"({"id": ")" << stored << R"(", "kind": "volume"})";
+  ASSERT_TRUE(store.is_volume(stored));
+  // A mesh is not a volume.
+  const std::string mesh_hex = assets::sha256_hex("mesh");
+  std::ofstream(dir / "assets" / (mesh_hex + ".mesh")) << "mesh";
+  std::ofstream(dir / "assets" / (mesh_hex + ".json")) << R"({"id": "sha256:)" << mesh_hex << R"("})";
   const std::string absent = "sha256:" + std::string(64, '7');
 
   CloudsSpec clouds;
@@ -76,6 +80,10 @@ TEST(AssetAdmission, CloudVolumesMustBeInTheStore) {
   EXPECT_NE(errors[0].rule.find("upload"), std::string::npos) << errors[0].rule;
   EXPECT_NE(errors[0].message().find(absent), std::string::npos) << errors[0].message();
   EXPECT_EQ(missing_volume_assets(clouds, nullptr).size(), 2u);
+  clouds.volumes[1].asset = "sha256:" + mesh_hex;
+  const auto mesh_errors = missing_volume_assets(clouds, &store);
+  ASSERT_EQ(mesh_errors.size(), 1u);
+  EXPECT_NE(mesh_errors[0].rule.find("not a cloud volume"), std::string::npos) << mesh_errors[0].rule;
   fs::remove_all(dir);
 }
 
