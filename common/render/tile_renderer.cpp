@@ -35,19 +35,19 @@ TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const Rende
   if (plan_.lut)
     lut_ = std::make_shared<const LutSky>(LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),
                                                         plan_.lambda_min_nm, plan_.lambda_max_nm));
-  build_lut_clouds();
+  build_lut_clouds({});
 }
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
-                           std::shared_ptr<const LutSky> lut)
+                           std::shared_ptr<const LutSky> lut, const CloudMarchOptions& clouds)
     : scene_(scene), camera_(camera), plan_(plan), integrator_(scene), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())),
       lut_(std::move(lut)) {
   plan_.lut = true;
-  build_lut_clouds();
+  build_lut_clouds(clouds);
 }
 
-void TileRenderer::build_lut_clouds() {
-  if (lut_ && scene_.clouds()) cloud_march_ = std::make_shared<const CloudMarch>(*lut_, *scene_.clouds());
+void TileRenderer::build_lut_clouds(const CloudMarchOptions& options) {
+  if (lut_ && scene_.clouds()) cloud_march_ = std::make_shared<const CloudMarch>(*lut_, *scene_.clouds(), options);
 }
 
 // One LUT sample per pixel: the centre's radiance, or for pixels that see

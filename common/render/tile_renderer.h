@@ -17,21 +17,21 @@
 #include <memory>
 
 #include "common/camera/camera.h"
+#include "common/lut/cloud_march.h"
 #include "common/film/film_tile.h"
 #include "common/render/render_plan.h"
 #include "common/render/volume_path_integrator.h"
 
 namespace skyfarm {
 
-class LutSky;
-class CloudMarch;
 
 class TileRenderer {
  public:
   TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan, IntegratorOptions options = {});
   // A LUT renderer on tables built elsewhere (a cache); `lut` must match the scene.
+  // `clouds`: the cloud march's options where the scene has clouds.
   TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
-               std::shared_ptr<const LutSky> lut);
+               std::shared_ptr<const LutSky> lut, const CloudMarchOptions& clouds = {});
 
   // A fresh film tile for tile t (all batches, zero).
   FilmTile empty_tile(int tile) const;
@@ -50,7 +50,7 @@ class TileRenderer {
 
  private:
   void render_unit_lut(const WorkUnit& unit, FilmTile* film) const;
-  void build_lut_clouds();
+  void build_lut_clouds(const CloudMarchOptions& options);
 
   const Scene& scene_;
   const Camera& camera_;
