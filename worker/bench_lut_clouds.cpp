@@ -154,11 +154,13 @@ int run_bench_lut_clouds(const std::vector<std::string>& args) {
       options.octave_a = std::atof(args[++i].c_str());
       options.octave_b = std::atof(args[++i].c_str());
       options.octave_c = std::atof(args[++i].c_str());
+    } else if (args[i] == "--two-stream") {
+      options.multiple_scattering = CloudMultipleScattering::kTwoStream;
     } else if (args[i] == "--no-ambient") {
       options.ambient = false;
     } else {
       std::cerr << "usage: skyfarm-worker bench lut-clouds [--out DIR] [--spp N] [--octaves N] [--octave-abc A B C] "
-                   "[--no-ambient]\n";
+                   "[--two-stream] [--no-ambient]\n";
       return 2;
     }
   }

@@ -17,7 +17,7 @@
 // out.  Per region, weighted by solid angle: the relative error of the mean
 // luminance, mean(Y_lut) / mean(Y_path) - 1, and the path tracer's own
 // estimated relative error of that mean.
-// --octaves N, --octave-abc A B C and --no-ambient set the LUT's cloud
+// --octaves N, --octave-abc A B C, --two-stream and --no-ambient set the LUT's cloud
 // march options (cloud_march.h; defaults otherwise) to compare variants.
 // Writes DIR/lut_clouds.csv and one JSON line per case.
 #pragma once

@@ -24,6 +24,32 @@ constexpr double kMaxStep_m = 250.0;
 constexpr int kMaxBins = 512;
 constexpr int kMaxOctaves = 16;
 
+// The diffuse radiance of a conservative slab in the Eddington
+// approximation, I(tau, mu) = I0(tau) + mu I1(tau) (mu > 0 upwards, tau
+// from the top), lit at the top by a beam of irradiance F0 (normal to it) at
+// cosine mu0, black below, no diffuse light entering at the top; g, tau
+// already delta-scaled.  The moments of the transfer equation with p = 1 +
+// 3 g mu mu' (omega = 1, k = 3 F0 / (4 pi), e(tau) = exp(-tau / mu0)):
+//   dI1/dtau = -k e,            I1 = C1 + k mu0 e
+//   dI0/dtau = (1 - g) I1 + k g mu0 e,   I0 = C2 + (1 - g) C1 tau - k mu0^2 e
+// with Marshak's conditions I0 - 2/3 I1 = 0 at tau = 0 and I0 + 2/3 I1 = 0
+// at tau = tau_total:
+//   C1 = -k [mu0^2 (1 - e_T) + 2/3 mu0 (1 + e_T)] / (4/3 + (1 - g) tau_total)
+//   C2 = 2/3 C1 + k mu0^2 + 2/3 k mu0.
+// (Checks: tau_total -> 0 gives I = 0; a deep slab reflects F0 mu0 at the
+// top: the upward flux 4 pi / 3 I1(0) -> F0 mu0.)  Per unit F0.
+struct TwoStream {
+  double I0 = 0.0, I1 = 0.0;
+};
+TwoStream two_stream_diffuse(double tau, double tau_total, double mu0, double g) {
+  constexpr double kPiLocal = 3.14159265358979323846;
+  const double k = 3.0 / (4.0 * kPiLocal);
+  const double e = std::exp(-tau / mu0), e_T = std::exp(-tau_total / mu0);
+  const double C1 = -k * (mu0 * mu0 * (1.0 - e_T) + 2.0 / 3.0 * mu0 * (1.0 + e_T)) / (4.0 / 3.0 + (1.0 - g) * tau_total);
+  const double C2 = 2.0 / 3.0 * C1 + k * mu0 * mu0 + 2.0 / 3.0 * k * mu0;
+  return {std::max(0.0, C2 + (1.0 - g) * C1 * tau - k * mu0 * mu0 * e), C1 + k * mu0 * e};
+}
+
 struct Piece {
   double t0, t1, sigma_maj;
   const CloudField* field;
@@ -84,6 +110,24 @@ double CloudMarch::sun_optical_depth(const glm::dvec3& p) const {
   return tau;
 }
 
+// tau straight down from p (radius r) to the clouds' bottom, sun_steps
+// steps doubling in length (at least one).
+double CloudMarch::down_optical_depth(const glm::dvec3& p, double r) const {
+  const double length = r - (R_ + clouds_.bottom_altitude_m());
+  if (!(length > 0.0)) return 0.0;
+  const int n = std::max(1, options_.sun_steps);
+  const glm::dvec3 down = -p / r;
+  double dt = length / (std::ldexp(1.0, n) - 1.0), t = 0.0, tau = 0.0;
+  for (int k = 0; k < n; ++k, dt *= 2.0) {
+    const glm::dvec3 q = p + (t + 0.5 * dt) * down;
+    double sigma = 0.0;
+    for (const auto& field : clouds_.fields()) sigma += field->sigma_t(q);
+    tau += sigma * dt;
+    t += dt;
+  }
+  return tau;
+}
+
 CloudMarch::Result CloudMarch::march(const Ray& ray, double t_max, std::span<double> L_cloud,
                                      std::span<double> T_cloud) const {
   const int B = sky_.grid().size();
@@ -114,12 +158,16 @@ CloudMarch::Result CloudMarch::march(const Ray& ray, double t_max, std::span<dou
   int budget = options_.max_steps;
   const CloudField* phase_field = nullptr;
   std::array<double, kMaxOctaves> octave_weight{};  // a^i p_i(cos theta), per field's phase
+  const bool two_stream = options_.multiple_scattering == CloudMultipleScattering::kTwoStream;
+  const int octaves = two_stream ? 1 : options_.octaves;
+  double g = 0.0;  // the field's asymmetry parameter
   for (std::size_t k = 0; k < pieces.size() && T >= options_.min_transmittance; ++k) {
     const Piece& piece = pieces[k];
     const CloudOptics& optics = piece.field->optics();
     if (piece.field != phase_field) {
       phase_field = piece.field;
       const double p = optics.phase.eval(cos_theta);
+      g = std::clamp(optics.phase.mean_cosine(), -0.99, 0.99);
       double a = 1.0, c = 1.0;
       for (int i = 0; i < options_.octaves; ++i, a *= options_.octave_a, c *= options_.octave_c)
         octave_weight[static_cast<std::size_t>(i)] = a * (c * p + (1.0 - c) / (4.0 * kPi));
@@ -143,8 +191,22 @@ CloudMarch::Result CloudMarch::march(const Ray& ray, double t_max, std::span<dou
       // air's transmittance and E_sun per bin.
       const double tau_sun = sun_optical_depth(p);
       double sun = 0.0, b_pow = 1.0;
-      for (int i = 0; i < options_.octaves; ++i, b_pow *= options_.octave_b)
-        sun += octave_weight[static_cast<std::size_t>(i)] * std::exp(-b_pow * tau_sun);
+      if (!two_stream) {
+        for (int i = 0; i < octaves; ++i, b_pow *= options_.octave_b)
+          sun += octave_weight[static_cast<std::size_t>(i)] * std::exp(-b_pow * tau_sun);
+      } else {
+        // Delta-Eddington (f = g^2): the beam keeps the forward peak's light,
+        // exp(-(1 - f) tau_sun), and scatters the rest with the phase function
+        // (its peak capped at the Eddington phase's largest value, so the
+        // peak's light is not counted twice); the diffuse field I0 + mu I1
+        // of the scaled slab is seen through the true phase function as
+        // f I(mu_v) + (1 - f)(I0 + g' mu_v I1) = I0 + g mu_v I1.
+        const double mu0 = std::max(glm::dot(up, s), 0.02), scale = 1.0 - g * g, g_scaled = g / (1.0 + g);
+        const double tau_above = scale * mu0 * tau_sun, tau_total = tau_above + scale * down_optical_depth(p, r);
+        const double p_beam = std::min(octave_weight[0], (1.0 + 3.0 * g_scaled) / (4.0 * kPi));
+        const TwoStream diffuse = two_stream_diffuse(tau_above, tau_total, mu0, g_scaled);
+        sun = p_beam * std::exp(-scale * tau_sun) + std::max(0.0, diffuse.I0 + g * glm::dot(-ray.d, up) * diffuse.I1);
+      }
       const double weight = T * optics.albedo * opacity;
       if (sun > 0.0) {
         sky_.transmittance_to_top(r, glm::dot(up, s), std::span<double>(T_air.data(), static_cast<std::size_t>(B)));

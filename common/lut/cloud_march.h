@@ -50,7 +50,24 @@
 // between clouds (beyond the octaves), clouds seen through other clouds'
 // aerial perspective at other depths.
 //
+// The two-stream alternative (kTwoStream): the point is taken to lie in a
+// horizontally uniform slab whose optical depth above it, seen from the sun,
+// is mu0 tau_sun (the marched sun path, so that a cumulus's sunlit side is
+// shallow whatever lies above it) and below it tau_down (a vertical march of
+// sun_steps doubling steps down to the clouds' bottom), black below.  Its
+// diffuse radiance I(mu) = I0 + mu I1 (Eddington) after delta scaling (Joseph,
+// Wiscombe & Weinman 1976: tau' = (1 - g^2) tau, g' = g / (1 + g)) is solved
+// in closed form (cloud_march.cpp).  J is then the scaled beam's single
+// scattering, p exp(-(1 - g^2) tau_sun) (p's forward peak capped at the
+// Eddington phase's (1 + 3 g') / (4 pi): the peak's light stays in the
+// beam), plus the diffuse field seen through the true phase function,
+// I0 + g mu_v I1, mu_v the cosine of the direction towards the camera to the
+// local up.  It reproduces the slab's diffuse reflectance
+// and transmittance (~1/(1 + 3/4 (1 - g) tau)), which the octaves miss by a
+// factor of several for tau >~ 5 (docs/experiments/*-lut-clouds.md).
+//
 // Parameters (CloudMarchOptions)
+//   multiple_scattering kOctaves (default) or kTwoStream
 //   max_steps          view-ray steps (192: a cumulus layer seen slantwise
 //                      crosses ~10-40 majorant pieces; 192 steps keep a
 //                      256 x 256 frame within seconds on 2 cores and the
@@ -71,7 +88,15 @@
 
 namespace skyfarm {
 
+// How the march approximates the light scattered more than once.
+//   kOctaves    Wrenninge's octaves (above)
+//   kTwoStream  single scattering (octave 0) plus the diffuse light of a
+//               plane-parallel, conservative delta-Eddington slab through
+//               the point (two_stream_diffuse below)
+enum class CloudMultipleScattering { kOctaves, kTwoStream };
+
 struct CloudMarchOptions {
+  CloudMultipleScattering multiple_scattering = CloudMultipleScattering::kOctaves;
   int max_steps = 192;
   int sun_steps = 6;
   int octaves = 4;
@@ -109,6 +134,7 @@ class CloudMarch {
 
  private:
   double sun_optical_depth(const glm::dvec3& p) const;
+  double down_optical_depth(const glm::dvec3& p, double r) const;
 
   const LutSky& sky_;
   const SceneClouds& clouds_;
