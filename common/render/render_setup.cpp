@@ -5,6 +5,7 @@
 #include <string>
 
 #include "common/assets/volume_source.h"
+#include "common/clouds/cloud_layer.h"
 #include "common/objects/placed_objects.h"
 
 namespace skyfarm {
@@ -26,8 +27,13 @@ std::shared_ptr<const SceneClouds> make_scene_clouds(const RenderSpec& spec, dou
   if (spec.clouds.empty()) return nullptr;
   std::vector<std::shared_ptr<const CloudField>> fields;
   const double time_s = wind_time_s(spec.time);
-  for (const CloudLayerSpec& layer : spec.clouds.layers)
-    (void)layer, (void)time_s, throw std::runtime_error("cloud layers: not built yet");  // TEMP until CloudLayer lands
+  // The air has moved by time x wind since J2000.  The world frame's +x and
+  // +y are the observer's east and north (ray.h), so the displacement there is
+  // (east, north, 0) x time; CloudLayer translates its noise rigidly by it.
+  for (const CloudLayerSpec& layer : spec.clouds.layers) {
+    const glm::dvec3 drift_m = time_s * glm::dvec3(layer.wind_m_s.x, layer.wind_m_s.y, 0.0);
+    fields.push_back(std::make_shared<CloudLayer>(layer, planet_radius_m, drift_m));
+  }
   if (!spec.clouds.volumes.empty()) {
     if (!volumes) throw std::runtime_error("cloud volumes need a volume source");
     throw std::runtime_error("cloud volumes are not available in this build");

@@ -69,7 +69,7 @@ TEST(CloudTransport, ConservativeSlabReflectsPlusTransmitsEverything) {
   const double zenith = 30.0, mu0 = std::cos(zenith * kDegToRad);
   for (const double tau : {1.0, 10.0}) {
     for (const bool forward : {false, true}) {
-      SCOPED_TRACE(testing::Message() << "tau " << tau << (forward ? " HG 0.85" : " isotropic"));
+      SCOPED_TRACE(::testing::Message() << "tau " << tau << (forward ? " HG 0.85" : " isotropic"));
       const CloudOptics optics = forward ? hg_cloud(0.85) : isotropic_cloud();
       const auto above = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabTop_m + 1.0);
       const auto below = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabBottom_m - 1.0);
