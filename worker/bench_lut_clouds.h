@@ -15,9 +15,11 @@
 // below, tops from above), gap (T_c > 0.95, above the horizon, seen from
 // below), and the whole frame; the sun's pixels (within 10 deg) are left
 // out.  Per region, weighted by solid angle: the relative error of the mean
-// luminance, mean(Y_lut) / mean(Y_path) - 1, and the path tracer's own
-// estimated relative error of that mean.
-// --octaves N, --octave-abc A B C, --two-stream and --no-ambient set the LUT's cloud
+// luminance, mean(Y_lut) / mean(Y_path) - 1, the median over the pixels of
+// Y_lut / Y_path - 1 (robust to the reference's rare bright outliers, which
+// clouds make common at a few hundred spp), and the path tracer's own
+// estimated relative error of the mean.
+// --octaves N, --octave-abc A B C, --octaves-only and --no-ambient set the LUT's cloud
 // march options (cloud_march.h; defaults otherwise) to compare variants.
 // Writes DIR/lut_clouds.csv and one JSON line per case.
 #pragma once

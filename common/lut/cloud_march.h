@@ -67,13 +67,14 @@
 // factor of several for tau >~ 5 (docs/experiments/*-lut-clouds.md).
 //
 // Parameters (CloudMarchOptions)
-//   multiple_scattering kOctaves (default) or kTwoStream
+//   multiple_scattering kTwoStream (default: the smaller error against the
+//                      path tracer, docs/experiments/*-lut-clouds.md) or kOctaves
 //   max_steps          view-ray steps (192: a cumulus layer seen slantwise
 //                      crosses ~10-40 majorant pieces; 192 steps keep a
 //                      256 x 256 frame within seconds on 2 cores and the
 //                      steps in dense pieces near kOpticalStep)
 //   sun_steps          secondary march steps towards the sun (6)
-//   octaves            multiple-scattering octaves (4; 1 = single scattering)
+//   octaves            kOctaves: octaves (4; 1 = single scattering)
 //   octave_a/_b/_c     scattering, extinction and eccentricity factors (0.5)
 //   ambient            add L_ambient (true)
 //   ambient_directions LUT sky marches per hemisphere for Phi (64)
@@ -96,7 +97,7 @@ namespace skyfarm {
 enum class CloudMultipleScattering { kOctaves, kTwoStream };
 
 struct CloudMarchOptions {
-  CloudMultipleScattering multiple_scattering = CloudMultipleScattering::kOctaves;
+  CloudMultipleScattering multiple_scattering = CloudMultipleScattering::kTwoStream;
   int max_steps = 192;
   int sun_steps = 6;
   int octaves = 4;

@@ -37,6 +37,7 @@ CloudOptics hg_cloud(double g, double albedo = 1.0) {
 
 CloudMarchOptions single_scattering() {
   CloudMarchOptions o;
+  o.multiple_scattering = CloudMultipleScattering::kOctaves;
   o.octaves = 1;
   o.ambient = false;
   return o;
@@ -228,6 +229,7 @@ TEST(CloudMarch, ThickSlabFluxesAgainstThePathTracer) {
   const SlabSky above = slab_sky(tau, hg_cloud(g), zenith, 3000.0), below = slab_sky(tau, hg_cloud(g), zenith, 0.0);
   CloudMarchOptions octaves, two_stream;
   octaves.ambient = two_stream.ambient = false;
+  octaves.multiple_scattering = CloudMultipleScattering::kOctaves;
   two_stream.multiple_scattering = CloudMultipleScattering::kTwoStream;
   const SlabFluxes o = lut_slab_fluxes(above, below, octaves), t = lut_slab_fluxes(above, below, two_stream);
   const auto R_pt = testing::hemisphere_flux_ratio(*above.scene, false, 20000, 5);
