@@ -111,16 +111,7 @@ void read_object(const Fields& f, ObjectSpec& o) {
     f.number("albedo", Range::closed(0, 1), a);
     o.material = lambertian_surface(a);
   }
-  read_vec3(f, "translate_m", Range::closed(-kMaxObjectDistance_m, kMaxObjectDistance_m), o.placement.translate_m);
-  read_vec3(f, "rotate_deg", Range::closed(-360, 360), o.placement.rotate_deg);
-  // One spelling per orientation: each angle in (-180, 180] (fmod is exact).
-  for (int i = 0; i < 3; ++i) {
-    double& a = o.placement.rotate_deg[i];
-    a = std::fmod(a, 360.0);
-    if (a > 180.0) a -= 360.0;
-    if (a <= -180.0) a += 360.0;
-  }
-  read_scale(f, o.placement.scale);
+  read_placement(f, o.placement);
 }
 
 Json vec3_json(const glm::dvec3& v) {
@@ -128,6 +119,25 @@ Json vec3_json(const glm::dvec3& v) {
 }
 
 }  // namespace
+
+void read_placement(const Fields& f, Placement& out) {
+  read_vec3(f, "translate_m", Range::closed(-kMaxObjectDistance_m, kMaxObjectDistance_m), out.translate_m);
+  read_vec3(f, "rotate_deg", Range::closed(-360, 360), out.rotate_deg);
+  // One spelling per orientation: each angle in (-180, 180] (fmod is exact).
+  for (int i = 0; i < 3; ++i) {
+    double& a = out.rotate_deg[i];
+    a = std::fmod(a, 360.0);
+    if (a > 180.0) a -= 360.0;
+    if (a <= -180.0) a += 360.0;
+  }
+  read_scale(f, out.scale);
+}
+
+void placement_json(const Placement& placement, Json& out) {
+  out["translate_m"] = vec3_json(placement.translate_m);
+  out["rotate_deg"] = vec3_json(placement.rotate_deg);
+  out["scale"] = vec3_json(placement.scale);
+}
 
 material::SurfaceSpec lambertian_surface(double albedo) {
   material::SurfaceSpec s;
@@ -171,9 +181,7 @@ Json objects_json(const std::vector<ObjectSpec>& objects) {
       j["albedo"] = canonical_number(o.material.albedo[0]);
     else
       j["material"] = material_json(o.material);
-    j["translate_m"] = vec3_json(o.placement.translate_m);
-    j["rotate_deg"] = vec3_json(o.placement.rotate_deg);
-    j["scale"] = vec3_json(o.placement.scale);
+    placement_json(o.placement, j);
     a.push_back(std::move(j));
   }
   return a;

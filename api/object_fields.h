@@ -34,6 +34,12 @@ void read_objects(const Fields& top, std::vector<ObjectSpec>& out);
 // The canonical "objects" array.
 Json objects_json(const std::vector<ObjectSpec>& objects);
 
+// The placement fields "translate_m", "rotate_deg", "scale" of the object `f`
+// (rules above; absent ones leave `out`), and their canonical members added to `out`.
+// Cloud volumes share them (api/cloud_fields.h).
+void read_placement(const Fields& f, Placement& out);
+void placement_json(const Placement& placement, Json& out);
+
 // The custom diffuse surface the shorthand "albedo": a stands for, and
 // whether a surface is one (its canonical form is then the shorthand).
 material::SurfaceSpec lambertian_surface(double albedo);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "api/cloud_fields.h"
 #include "api/object_fields.h"
 
 namespace skyfarm::api {
@@ -152,7 +153,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   if (!body.is_object()) throw ValidationError({FieldError{"", "must be a JSON object", value_text(body)}});
   Fields top(body, "", e);
   top.allow_only({"location", "time", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output",
-                  "seed", "priority", "objects"});
+                  "seed", "priority", "objects", "clouds"});
   RenderRequest r;
   read_location(top, r.location);
   read_time(top, r.time, r.time_text);
@@ -161,6 +162,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   read_camera(top, r.camera);
   read_atmosphere(top, r.atmosphere);
   read_objects(top, r.objects);
+  read_clouds(top, r.clouds);
   read_spectral(top, r.spectral);
   read_quality(top, r.quality);
   read_method(top, r.method);
@@ -169,6 +171,9 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   top.integer("priority", 0, 100, r.priority);
   if (r.method == Method::kLut && !r.objects.empty())
     e.add("objects", "the lut method renders the sky alone: objects need \"method\": \"path\"");
+  // The LUT renderer ray-marches cloud layers; placed volumes need the path tracer.
+  if (r.method == Method::kLut && !r.clouds.volumes.empty())
+    e.add("clouds.volumes", "the lut method renders cloud layers only: cloud volumes need \"method\": \"path\"");
   e.throw_if_any();
   return r;
 }
@@ -237,6 +242,8 @@ nlohmann::json to_canonical_json(const RenderRequest& r) {
           {"priority", r.priority}};
   // Written only when there are objects: requests without keep their text.
   if (!r.objects.empty()) j["objects"] = objects_json(r.objects);
+  // Likewise clouds: a clear-sky request keeps its text (its hash, its cache).
+  if (!r.clouds.empty()) j["clouds"] = clouds_json(r.clouds);
   return j;
 }
 

@@ -14,6 +14,7 @@
 #include "api/json_fields.h"
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera_spec.h"
+#include "common/clouds/cloud_spec.h"
 #include "common/objects/object_spec.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
@@ -66,6 +67,7 @@ struct RenderRequest {
   CameraSpec camera;
   AtmosphereSpec atmosphere;
   std::vector<ObjectSpec> objects;  // api/object_fields.h
+  CloudsSpec clouds;                // api/cloud_fields.h; empty: a clear sky
   SpectralSpec spectral;
   QualitySpec quality;
   Method method = Method::kPath;

@@ -9,6 +9,7 @@ RenderSpec render_spec(const RenderRequest& request) {
   spec.sun = request.sun;
   spec.atmosphere = request.atmosphere;
   spec.objects = request.objects;
+  spec.clouds = request.clouds;
   spec.camera = request.camera;
   spec.lambda_min_nm = request.spectral.min_nm;
   spec.lambda_max_nm = request.spectral.max_nm;

@@ -8,7 +8,7 @@ namespace {
 
 // The render request's top-level fields a timelapse shares ("time" excluded).
 constexpr std::string_view kRenderFields[] = {"location", "sun",    "camera", "atmosphere", "spectral", "quality",
-                                              "method",   "output", "seed",   "priority"};
+                                              "method",   "output", "seed",   "priority", "clouds"};
 // Used in place of "time" while the shared fields are validated (the render
 // parser needs a time or sun angles); any valid instant will do.
 constexpr const char* kPlaceholderTime = "2000-01-01T00:00:00Z";
@@ -163,8 +163,8 @@ TimelapseRequest read_timelapse_request(const Json& body, int max_frames, Errors
     Json others = body;
     others.erase("time");
     Fields(others, "", e).allow_only({"location", "sun", "camera", "atmosphere", "spectral", "quality", "method",
-                                      "output", "seed", "priority", "start", "end", "step_s", "frames", "same_seed",
-                                      "exposure_smoothing_frames", "video_fps"});
+                                      "output", "seed", "priority", "clouds", "start", "end", "step_s", "frames",
+                                      "same_seed", "exposure_smoothing_frames", "video_fps"});
   }
   Fields top(body, "", e);
   TimelapseRequest r;

@@ -26,9 +26,29 @@ constexpr int kOctaves = 3;
 // fBm weights, gain 1/2, normalised: the fBm is a convex combination of
 // values in [0, 1), so it lies in [0, 1).
 constexpr std::array<double, kOctaves> kOctaveWeight = {4.0 / 7.0, 2.0 / 7.0, 1.0 / 7.0};
-// The width of the coverage remap's ramp in fBm units: a cloud's edge
-// takes this share of the fBm's range to go from nothing to full.
-constexpr double kCoverageRamp = 0.3;
+// The majorant grid's cells per scale_m: a power of two >= 2^(kOctaves - 1),
+// so that a cell lies inside one lattice cell of every octave.
+constexpr int kCellsPerScale = 8;
+static_assert((kCellsPerScale & (kCellsPerScale - 1)) == 0 && kCellsPerScale >= (1 << (kOctaves - 1)));
+// The width of the coverage remap's ramp in fBm units: a cloud's edge goes
+// from nothing to full over this rise of the fBm (its standard deviation is 0.131).
+constexpr double kCoverageRamp = 0.1;
+// Where the ramp starts for coverage c = 0, 0.05, ..., 1: the fBm's (1 - c)
+// quantile, so that the share of the area holding cloud (on the profile's
+// plateau, before erosion) is c.  Measured over 2e6 random points, seeds
+// 1-16 (docs/experiments/2026-12-07-cloud-layer.md); symmetric about 0.5 as
+// the fBm's distribution is.  The ends: 1 (above every fBm: no cloud) and
+// -kCoverageRamp (the ramp ends at 0: full everywhere).
+constexpr std::array<double, 21> kCoverageThreshold = {
+    1.0,    0.7149, 0.6721, 0.6416, 0.6163, 0.5940, 0.5736, 0.5543, 0.5358, 0.5178, 0.5000,
+    0.4822, 0.4642, 0.4457, 0.4264, 0.4059, 0.3837, 0.3583, 0.3279, 0.2852, -kCoverageRamp};
+
+double coverage_threshold(double coverage) {
+  const double x = coverage * 20.0;
+  const auto i = static_cast<std::size_t>(std::min(19.0, std::floor(x)));
+  const double f = x - static_cast<double>(i);
+  return kCoverageThreshold[i] + f * (kCoverageThreshold[i + 1] - kCoverageThreshold[i]);
+}
 // The largest erosion amount: (d - a) / (1 - a) stays finite.
 constexpr double kMaxErosion = 0.99;
 // |grad fbm| per lattice unit is at most sum_o w_o 2^o x 1.875 (the quintic
@@ -53,7 +73,8 @@ struct CloudLayer::Impl {
   CloudProfile profile;
   TiledWorleyNoise detail;
   std::array<std::uint64_t, kOctaves> octave_seed{};
-  double detail_spacing_m = 0.0;  // one table sample
+  double inv_scale = 0.0;           // 1 / scale_m
+  double inv_detail_spacing = 0.0;  // 1 / (one table sample, m)
   double coverage_lo = 0.0;       // the fBm where the remap's ramp starts
   bool empty = false;             // coverage 0 or sigma_max 0: no cloud at all
 
@@ -81,14 +102,15 @@ struct CloudLayer::Impl {
                                       : s.water_content_g_m3 * optics.extinction_per_g_m3;
     for (int o = 0; o < kOctaves; ++o)
       octave_seed[static_cast<std::size_t>(o)] = hash_keys(s.seed, kNoiseSalt, static_cast<std::uint64_t>(o), 0);
-    detail_spacing_m = s.detail_scale_m * TiledWorleyNoise::kCells / TiledWorleyNoise::kSize;
-    coverage_lo = (1.0 - s.coverage) * (1.0 + kCoverageRamp) - kCoverageRamp;
+    inv_scale = 1.0 / s.scale_m;
+    inv_detail_spacing = TiledWorleyNoise::kSize / (s.detail_scale_m * TiledWorleyNoise::kCells);
+    coverage_lo = coverage_threshold(s.coverage);
     empty = s.coverage == 0.0 || !(sigma_max > 0.0);
   }
 
   // The coverage remap, monotone in the fBm: 0 for fbm <= lo, 1 for
   // fbm >= lo + ramp (division, not a reciprocal, so that coverage 1 gives
-  // exactly 1 at fbm = 0).
+  // exactly 1 at fbm = 0: (0 + ramp) / ramp).
   double shape_of(double fbm) const { return std::clamp((fbm - coverage_lo) / kCoverageRamp, 0.0, 1.0); }
 
   double density(const glm::dvec3& p) const {
@@ -98,30 +120,42 @@ struct CloudLayer::Impl {
     const double prof = profile((h - spec.base_m) / spec.thickness_m);
     if (prof == 0.0) return 0.0;
     const glm::dvec3 q = p - drift;
-    const glm::dvec3 x = q / spec.scale_m;
-    double fbm = 0.0, frequency = 1.0;
-    for (int o = 0; o < kOctaves; ++o, frequency *= 2.0)
-      fbm += kOctaveWeight[static_cast<std::size_t>(o)] *
-             value_noise(octave_seed[static_cast<std::size_t>(o)], x * frequency);
+    const glm::dvec3 x = q * inv_scale;  // within an ulp of q / scale_m: the walk's margin covers it
+    // Octave by octave, stopping once even full values of the octaves left
+    // could not lift the fBm over the coverage threshold (clear air is the
+    // common case at low coverage).
+    double fbm = 0.0, frequency = 1.0, rest = 1.0;
+    for (int o = 0; o < kOctaves; ++o, frequency *= 2.0) {
+      const auto i = static_cast<std::size_t>(o);
+      fbm += kOctaveWeight[i] * value_noise(octave_seed[i], x * frequency);
+      rest -= kOctaveWeight[i];
+      if (fbm + rest <= coverage_lo) return 0.0;
+    }
     const double shape = shape_of(fbm);
     if (shape == 0.0) return 0.0;
     double d = shape * prof;
     if (spec.erosion > 0.0) {
-      const double a = std::min(kMaxErosion, spec.erosion * detail.lookup(q / detail_spacing_m));
+      const double a = std::min(kMaxErosion, spec.erosion * detail.lookup(q * inv_detail_spacing));
       d = std::min(d, std::max(0.0, (d - a) / (1.0 - a)));
     }
     return d;
   }
 
-  // The shape's bound over the coarse cell c: each octave's largest lattice
-  // value over the cell, plus the margin for points placed err_m off; the
-  // finer octaves only when the coarser ones leave the cell possibly cloudy.
-  double cell_shape_bound(std::int64_t cx, std::int64_t cy, std::int64_t cz, double fbm_margin) const {
-    double known = fbm_margin, rest = 1.0;
-    for (int o = 0; o < kOctaves; ++o) {
+  // The shape's bound over the majorant grid's cell c (kCellsPerScale per
+  // scale_m, so inside one lattice cell of every octave): each octave's
+  // maximum over the box (its corners, value_noise.h), plus the margin for
+  // points placed err_m off; the finer octaves only when the coarser ones
+  // leave the cell possibly cloudy.
+  double cell_shape_bound(std::int64_t cx, std::int64_t cy, std::int64_t cz, double fbm_margin,
+                          std::array<ValueNoiseCell, kOctaves>& cache) const {
+    const glm::dvec3 lo = glm::dvec3(static_cast<double>(cx), static_cast<double>(cy), static_cast<double>(cz)) /
+                          static_cast<double>(kCellsPerScale);  // exact: a power of two
+    const glm::dvec3 hi = lo + 1.0 / kCellsPerScale;
+    double known = fbm_margin, rest = 1.0, frequency = 1.0;
+    for (int o = 0; o < kOctaves; ++o, frequency *= 2.0) {
       const auto i = static_cast<std::size_t>(o);
       rest -= kOctaveWeight[i];
-      known += kOctaveWeight[i] * value_noise_cell_max(octave_seed[i], cx, cy, cz, 1 << o);
+      known += kOctaveWeight[i] * value_noise_box_max(octave_seed[i], lo * frequency, hi * frequency, cache[i]);
       if (shape_of(known + std::max(0.0, rest)) == 0.0) return 0.0;
     }
     return shape_of(known);
@@ -145,14 +179,14 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
   const ShellIntervals shell = shell_intervals(ray, m.r_bottom, m.r_top, t_begin, t_end);
   if (shell.count == 0) return;
   const double t_last = shell.t1[static_cast<std::size_t>(shell.count - 1)];
-  const double scale = m.spec.scale_m, base = m.spec.base_m, thickness = m.spec.thickness_m;
+  const double cell_m = m.spec.scale_m / kCellsPerScale, base = m.spec.base_m, thickness = m.spec.thickness_m;
 
   // How far a point's coordinates may be off between this traversal and
   // sigma_t (o + t d - drift vs (o - drift) + t d, |p| vs the radial form):
   // a few ulps of the largest magnitude involved, and 1 mm for the altitude.
   const double err_m = 16.0 * std::numeric_limits<double>::epsilon() *
                        (glm::length(m.drift) + glm::length(ray.o) + std::abs(t_last) + m.r_top);
-  const double fbm_margin = 1e-12 + kFbmLipschitz * err_m / scale;
+  const double fbm_margin = 1e-12 + kFbmLipschitz * err_m / m.spec.scale_m;
   const double altitude_margin = 1e-3 + err_m;
 
   // The altitude bins' boundaries along the ray, sorted: r(t)^2 = l^2 + (t + b)^2.
@@ -208,13 +242,14 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
     }
   };
 
+  std::array<ValueNoiseCell, kOctaves> lattice_cache;  // neighbouring cells share lattice values
   const glm::dvec3 o = ray.o - m.drift;  // the ray in the noise's frame
   const glm::dvec3& d = ray.d;
   for (int s = 0; s < shell.count && !stopped; ++s) {
     const double a = shell.t0[static_cast<std::size_t>(s)], b = shell.t1[static_cast<std::size_t>(s)];
-    // 3-D DDA through the scale_m lattice (Amanatides & Woo 1987), each
+    // 3-D DDA through the majorant grid (Amanatides & Woo 1987), each
     // boundary's t computed from its integer index (no accumulated error).
-    const glm::dvec3 start = (o + a * d) / scale;
+    const glm::dvec3 start = (o + a * d) / cell_m;
     std::array<std::int64_t, 3> cell{static_cast<std::int64_t>(std::floor(start.x)),
                                      static_cast<std::int64_t>(std::floor(start.y)),
                                      static_cast<std::int64_t>(std::floor(start.z))};
@@ -224,7 +259,7 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
       const auto i = static_cast<std::size_t>(axis);
       if (step[i] == 0) return std::numeric_limits<double>::infinity();
       const std::int64_t face = step[i] > 0 ? cell[i] + 1 : cell[i];
-      return (static_cast<double>(face) * scale - o[axis]) / d[axis];
+      return (static_cast<double>(face) * cell_m - o[axis]) / d[axis];
     };
     for (int axis = 0; axis < 3; ++axis) {
       step[static_cast<std::size_t>(axis)] = d[axis] > 0.0 ? 1 : d[axis] < 0.0 ? -1 : 0;
@@ -236,7 +271,7 @@ void CloudLayer::for_each_majorant(const Ray& ray, double t_begin, double t_end,
       const auto i = static_cast<std::size_t>(axis);
       const double t_exit = std::min(t_next[i], b);
       if (t_exit > t) {
-        const double shape_bound = m.cell_shape_bound(cell[0], cell[1], cell[2], fbm_margin);
+        const double shape_bound = m.cell_shape_bound(cell[0], cell[1], cell[2], fbm_margin, lattice_cache);
         if (shape_bound > 0.0) cell_piece(t, t_exit, shape_bound);
         t = t_exit;
       }

@@ -9,12 +9,11 @@
 //   shape        coverage remap of a value-noise fBm (value_noise.h): three
 //                octaves, lattices of scale_m, scale_m / 2, scale_m / 4 in
 //                planet-centred coordinates, weights 4/7, 2/7, 1/7; then
-//                shape = clamp((fbm - lo) / w, 0, 1), w = 0.3,
-//                lo = (1 - coverage)(1 + w) - w, so that coverage 0 gives
-//                no cloud anywhere (fbm < 1) and 1 full cloud everywhere
-//                (fbm >= 0).  The covered share of the area grows with the
-//                coverage but is not equal to it (the fBm is not uniform);
-//                docs/experiments/2026-12-07-cloud-layer.md has the measure.
+//                shape = clamp((fbm - lo) / 0.1, 0, 1) with lo the fBm's
+//                (1 - coverage) quantile (a measured table), so that the
+//                share of the area holding cloud is the coverage; coverage 0
+//                gives no cloud anywhere (lo = 1 > fbm) and 1 full cloud
+//                everywhere (lo = -0.1: the ramp ends at fbm = 0).
 //   profile(x)   the type's height profile (cloud_profile.h), in [0, 1];
 //   detail       Worley noise of cells detail_scale_m (tiled_worley_noise.h),
 //                a table of period 4 detail_scale_m;
@@ -36,19 +35,23 @@
 // Lattice cells are 64-bit integers from floor(q / scale) in doubles.
 //
 // Majorants (cloud_field.h's contract, exact): every step is monotone in
-// the fBm and in the profile, and erosion only lowers the density, so over
-// a coarse cell of the scale_m lattice and an altitude range the density is
-// at most shape(max of each octave's lattice values over the cell) x the
-// profile's maximum over the range.  for_each_majorant steps through the
-// cells the ray crosses inside the shell (shell_intervals.h, then a 3-D DDA,
-// Amanatides & Woo 1987), splits each at kAltitudeBins altitude bins, skips
-// cells whose bound is 0 (cloud-free air costs one bound per cell) and
-// merges neighbours with equal bounds.
+// the fBm and in the profile, and erosion only lowers the density.  The
+// majorant grid has cells of scale_m / 8, each inside one lattice cell of
+// every octave, where value noise is largest at one of the box's corners
+// (value_noise.h): the shape's bound is the remap of the sum over octaves of
+// their corner maxima, times the profile's maximum over the piece's altitude
+// range.  for_each_majorant steps through the cells the ray crosses inside
+// the shell (shell_intervals.h, then a 3-D DDA, Amanatides & Woo 1987),
+// splits each at kAltitudeBins altitude bins, skips cells whose bound is 0
+// (cloud-free air costs one bound per cell) and merges neighbours with
+// equal bounds.  A margin of a few ulps of the coordinates covers the
+// rounding between the walk and sigma_t.
 //
 // Parameters: CloudLayerSpec (cloud_spec.h); planet_radius_m, the ground's
 // radius; drift_m as above.  Throws std::invalid_argument for a spec out of
 // range (coverage or erosion outside [0, 1], a thickness, scale or detail
-// scale <= 0, a negative base, water content or optical depth).
+// scale <= 0, a negative base, water content or optical depth; and
+// cloud_optics' error for an effective radius outside its range).
 // Pure functions of the spec: the same bits on every worker.
 #pragma once
 #include <memory>

@@ -5,12 +5,12 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/core/constants.h"
 #include "common/data/csv_table.h"
 
 namespace skyfarm {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Density of ice Ih near 0 C, kg m^-3 (Hobbs 1974, Ice Physics).
 constexpr double kIceDensity_kg_m3 = 917.0;
 

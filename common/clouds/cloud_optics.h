@@ -12,16 +12,21 @@
 // Parameters
 //   particle             water (Mie droplets) or ice (cirrus crystals)
 //   effective_radius_um  water: 0.5-25 um (the summary table's range; the
-//                        extinction and albedo interpolated in it); ice: any
-//                        radius > 0 (geometric optics)
+//                        extinction, albedo and g interpolated linearly in
+//                        it); ice: any finite radius > 0 (geometric optics,
+//                        Q_ext = 2: sigma_t = 3 IWC / (2 rho_ice r_eff))
 // Outputs (CloudOptics)
 //   extinction_per_g_m3  sigma_t in m^-1 per g m^-3 of condensed water
 //   albedo               single-scattering albedo
 //   phase                the phase function (PhaseFunction, sampled exactly):
 //                        water: the tabulated Mie phase of r_eff = 10 um (glory,
-//                        fogbow, forward peak) for every radius; ice: a
-//                        documented model (see the .cpp)
-//   asymmetry            <cos theta> of the particle at its radius (the table's g)
+//                        fogbow, forward peak) for every radius, built once
+//                        and shared; ice: 1/2 HG(0.98) + 1/2 HG(0.52)
+//                        (diffraction + roughened-crystal ray optics, g = 0.75;
+//                        see the .cpp), tabulated so that it is sampled exactly
+//   asymmetry            <cos theta> of the particle at its radius: water, the
+//                        Mie table's g (0.76-0.875; the shared phase's own
+//                        mean cosine is 0.864, the 10 um value); ice, 0.75
 //
 // Throws std::invalid_argument for a radius outside the range.
 #pragma once

@@ -3,15 +3,16 @@
 // point, blended inside each cell with Perlin's (2002) quintic fade
 // 6t^5 - 15t^4 + 10t^3 (C2: no creases in the clouds).
 //
-// The blend is trilinear with faded weights in [0, 1], a convex combination
-// of the cell's 8 corner values: the noise anywhere in a cell is at most the
-// largest of its corners.  That is the cloud layer's majorant.
+// The blend is trilinear in the faded coordinates, each monotone in its
+// coordinate: over any box inside one cell the noise is largest at one of
+// the box's corners.  That is the cloud layer's majorant.
 //
 // Lattice points are 64-bit integers and the hash is pure integer
 // arithmetic (MurmurHash3's finaliser over a mix of the coordinates and the
 // seed): the same bits on every machine, for points up to 2^63 cells away
 // (the wind's drift since J2000 reaches 1e10 m, ~1e7 cells).
 #pragma once
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -48,9 +49,23 @@ inline double value_noise(std::uint64_t seed, const glm::dvec3& x) {
   return lerp(w, lerp(v, lerp(u, c000, c100), lerp(u, c010, c110)), lerp(v, lerp(u, c001, c101), lerp(u, c011, c111)));
 }
 
-// The largest lattice value over the cell [c, c + 1]^3 of a lattice that is
-// `n` times coarser, i.e. over the points n c + (0..n) on each axis: the
-// bound of the noise (at n times the frequency) over that coarse cell.
-double value_noise_cell_max(std::uint64_t seed, std::int64_t cx, std::int64_t cy, std::int64_t cz, int n);
+// The 8 lattice values of one cell, fetched once for the many boxes a
+// majorant walk takes inside it.
+struct ValueNoiseCell {
+  std::int64_t x = 0, y = 0, z = 0;
+  bool valid = false;
+  std::array<double, 8> c{};  // index: dx + 2 dy + 4 dz
+  // Holds the cell (ix, iy, iz) of `seed` afterwards (fetches when it did not).
+  void fetch(std::uint64_t seed, std::int64_t ix, std::int64_t iy, std::int64_t iz);
+};
+
+// The largest value of the noise over the box [lo, hi] (lattice units),
+// which must lie inside one lattice cell (faces included).  Inside a cell
+// the noise is multilinear in (fade(x), fade(y), fade(z)) and the fade is
+// monotone, so its maximum over the box is at one of the box's 8 corners:
+// this is the exact maximum, not only a bound (up to rounding).  `cache`
+// keeps the cell's lattice values between calls.
+double value_noise_box_max(std::uint64_t seed, const glm::dvec3& lo, const glm::dvec3& hi, ValueNoiseCell& cache);
+double value_noise_box_max(std::uint64_t seed, const glm::dvec3& lo, const glm::dvec3& hi);
 
 }  // namespace skyfarm

@@ -713,6 +713,10 @@ bool VolumePathIntegrator::survives(PathState* st, const glm::dvec3& p, const gl
     ++c.counters->depth_limit;
     return false;
   }
+  if (depth + 1 >= options_.depth_rr_start) {
+    if (c.sampler.next() >= options_.depth_rr_survival) return false;
+    st->beta *= 1.0 / options_.depth_rr_survival;
+  }
   const SampledSpectrum rr_beta = st->beta * (1.0 / st->r_u.average());
   const bool in_shadow = in_planet_shadow(p);
   const double w = in_shadow ? options_.rr_threshold_in_shadow : 1.0;

@@ -70,7 +70,20 @@ enum class SurfaceSunSampling { kMis, kSunOnly, kBsdfOnly };
 enum class SurfaceMisHeuristic { kBalance, kPower };
 
 struct IntegratorOptions {
-  int max_depth = 10000;
+  int max_depth = 100000;
+  // Russian roulette on the depth alone: from depth_rr_start on, a path goes
+  // on with probability depth_rr_survival and survivors carry 1/survival.
+  // Unbiased, and it bounds the expected cost of a walk that nothing else
+  // stops (albedo 1 in a thick cloud: the throughput never falls) by
+  // about depth_rr_start + 1/(1 - survival) scatterings, while the hard cap
+  // (max_depth) is reached with probability survival^(max_depth -
+  // depth_rr_start) ~ 1e-39.  No sky or object path comes near it (air x100:
+  // ~250 events): their bytes are those of the old hard cap at 10000.  The
+  // price is variance where the light needs longer walks: diffuse
+  // transmission through optical depths of hundreds takes ~(tau (1 - g))^2 /
+  // (1 - g) scatterings (docs/experiments/2026-12-07-thick-clouds.md).
+  int depth_rr_start = 10000;
+  double depth_rr_survival = 0.999;
   SurfaceSunSampling surface_sun_sampling = SurfaceSunSampling::kMis;
   SurfaceMisHeuristic surface_mis_heuristic = SurfaceMisHeuristic::kPower;
   int rr_start_depth = 2;

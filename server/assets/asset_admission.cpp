@@ -20,4 +20,17 @@ std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objec
   return errors;
 }
 
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store) {
+  std::vector<api::FieldError> errors;
+  for (std::size_t i = 0; i < clouds.volumes.size(); ++i) {
+    const std::string& asset = clouds.volumes[i].asset;
+    if (store != nullptr && store->meta(asset)) continue;
+    errors.push_back({"clouds.volumes[" + std::to_string(i) + "].asset",
+                      store != nullptr ? "no such asset on this server; upload the volume first (POST /v1/assets)"
+                                       : "this server has no asset store",
+                      "\"" + asset + "\""});
+  }
+  return errors;
+}
+
 }  // namespace skyfarm::server

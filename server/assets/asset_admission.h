@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "api/field_error.h"
+#include "common/clouds/cloud_spec.h"
 #include "common/objects/object_spec.h"
 
 namespace skyfarm::server {
@@ -15,5 +16,8 @@ class AssetStore;
 // The errors for mesh objects whose asset `store` lacks (all of them when
 // there is no store); empty when the request may be admitted.
 std::vector<api::FieldError> missing_assets(const std::vector<ObjectSpec>& objects, const AssetStore* store);
+
+// Likewise for the cloud volumes' assets (clouds.volumes[i].asset).
+std::vector<api::FieldError> missing_volume_assets(const CloudsSpec& clouds, const AssetStore* store);
 
 }  // namespace skyfarm::server

@@ -388,10 +388,12 @@ void HttpApi::submit(const Request& req, Response& res, const ContentReader& rea
   send_json(res, 202, answer);
 }
 
-// The mesh assets a request's objects name must be in the store before a job
-// is made, or every worker would fail its units (400 naming objects[i].asset).
+// The mesh assets a request's objects name, and the volumes its clouds name,
+// must be in the store before a job is made, or every worker would fail its
+// units (400 naming objects[i].asset or clouds.volumes[i].asset).
 void HttpApi::admit_objects(const api::RenderRequest& request) const {
   std::vector<api::FieldError> errors = missing_assets(api::render_spec(request).objects, options_.assets);
+  for (api::FieldError& e : missing_volume_assets(request.clouds, options_.assets)) errors.push_back(std::move(e));
   if (!errors.empty()) throw api::ValidationError(std::move(errors));
 }
 

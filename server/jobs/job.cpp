@@ -57,6 +57,13 @@ nlohmann::json objects_report(const std::vector<ObjectSpec>& objects) {
   return {{"count", objects.size()}, {"shapes", shapes}, {"bvh", bvh}};
 }
 
+// The clouds a request names: its layers by type (in order) and its volumes.
+nlohmann::json clouds_report(const CloudsSpec& clouds) {
+  nlohmann::json types = nlohmann::json::array();
+  for (const CloudLayerSpec& layer : clouds.layers) types.push_back(std::string(cloud_type_name(layer.type)));
+  return {{"layers", clouds.layers.size()}, {"layer_types", types}, {"volumes", clouds.volumes.size()}};
+}
+
 }  // namespace
 
 nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& plan) {
@@ -76,6 +83,8 @@ nlohmann::json plan_report(const api::RenderRequest& request, const RenderPlan& 
           {"shadow_guide", plan.shadow_guide},     {"adaptive", plan.adaptive},
           {"pooled_ground_row", plan.pooled_ground_row >= 0 ? nlohmann::json(plan.pooled_ground_row) : nlohmann::json()}};
   if (!request.objects.empty()) report["objects"] = objects_report(request.objects);
+  // Nothing for a clear sky: its report stays as it was.
+  if (!request.clouds.empty()) report["clouds"] = clouds_report(request.clouds);
   return report;
 }
 

@@ -3,7 +3,9 @@
 // with empty caches; the image is byte-identical to `skyfarm-worker render`
 // of the same request naming the mesh file; each worker fetches the asset at
 // most once; a worker killed mid-job costs nothing; a request naming an
-// asset the server lacks is refused before it becomes a job.
+// asset the server lacks is refused before it becomes a job, and so is a
+// cloud volume's (clouds.volumes[i].asset), while cloud layers, which name
+// no asset, are admitted and counted in the plan.
 #include <gtest/gtest.h>
 
 #include <regex>
@@ -140,6 +142,34 @@ TEST(FarmAssets, AnAssetTheServerLacksIsRefusedBeforeAJobIsMade) {
   const auto list = client.Get("/v1/renders");
   ASSERT_TRUE(list);
   EXPECT_EQ(nlohmann::json::parse(list->body)["total"], 0) << "no job was made";
+}
+
+TEST(FarmAssets, ACloudVolumeTheServerLacksIsRefusedButLayersAreAdmitted) {
+  const fs::path dir = fresh_dir("clouds");
+  FarmServer server(dir / "data", 0);
+  ASSERT_TRUE(server.ok()) << server.log();
+  auto client = server.client();
+  const std::string sky = R"({"sun": {"zenith_deg": 40, "azimuth_deg": 200}, "camera": {"projection": "fisheye",
+      "width": 16, "height": 16}, "clouds": )";
+  const std::string unknown = "sha256:" + std::string(64, '9');
+  const auto refused = client.Post(
+      "/v1/renders", sky + R"({"layers": [{"type": "cumulus"}], "volumes": [{"asset": ")" + unknown + R"("}]}})",
+      "application/json");
+  ASSERT_TRUE(refused);
+  EXPECT_EQ(refused->status, 400) << refused->body;
+  EXPECT_NE(refused->body.find("clouds.volumes[0].asset"), std::string::npos) << refused->body;
+  const auto list = client.Get("/v1/renders");
+  ASSERT_TRUE(list);
+  EXPECT_EQ(nlohmann::json::parse(list->body)["total"], 0) << "no job was made";
+
+  const auto admitted =
+      client.Post("/v1/renders", sky + R"({"layers": [{"type": "stratus"}, {"type": "cirrus"}]}})", "application/json");
+  ASSERT_TRUE(admitted);
+  ASSERT_EQ(admitted->status, 202) << admitted->body;
+  const nlohmann::json status = server.status(nlohmann::json::parse(admitted->body)["id"].get<std::string>());
+  EXPECT_EQ(status["plan"]["clouds"],
+            nlohmann::json::parse(R"({"layers": 2, "layer_types": ["stratus", "cirrus"], "volumes": 0})"))
+      << status.dump();
 }
 
 }  // namespace

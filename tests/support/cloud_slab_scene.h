@@ -10,6 +10,7 @@
 // planet's radius makes the slab a shell; over the few kilometres the paths
 // wander it is plane-parallel to ~1e-4.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -28,15 +29,17 @@ constexpr double kSlabBottom_m = 1000.0, kSlabTop_m = 2000.0, kSlabLambda_nm = 5
 
 // The slab of optical depth tau (vertical) between kSlabBottom_m and
 // kSlabTop_m; the observer at `observer_altitude_m`; the sun at `sun_zenith_deg`.
+// (Or between bottom_m and top_m.)
 inline std::unique_ptr<Scene> cloud_slab_scene(double tau, CloudOptics optics, double sun_zenith_deg,
-                                               double observer_altitude_m) {
-  // "Airless": a 10 km layer whose scattering is 1e-15 per metre.
-  auto scene = std::make_unique<Scene>(Scene::from_specs(thin_hg_layer(1e-15, 10000.0, 0.0),
+                                               double observer_altitude_m, double bottom_m = kSlabBottom_m,
+                                               double top_m = kSlabTop_m) {
+  // "Airless": a layer (10 km, or 1 km above the slab) whose scattering is 1e-15 per metre.
+  auto scene = std::make_unique<Scene>(Scene::from_specs(thin_hg_layer(1e-15, std::max(10000.0, top_m + 1000.0), 0.0),
                                                          sun_spec(sun_zenith_deg, 0.0, 0.0),
                                                          Location{0.0, 0.0, observer_altitude_m}, std::nullopt,
                                                          500.0, 600.0));
-  const double sigma = tau / (kSlabTop_m - kSlabBottom_m);
-  auto slab = std::make_shared<UniformCloudSlab>(scene->atmosphere().planet_radius_m(), kSlabBottom_m, kSlabTop_m,
+  const double sigma = tau / (top_m - bottom_m);
+  auto slab = std::make_shared<UniformCloudSlab>(scene->atmosphere().planet_radius_m(), bottom_m, top_m,
                                                  sigma, std::move(optics));
   scene->set_clouds(std::make_shared<SceneClouds>(std::vector<std::shared_ptr<const CloudField>>{slab}));
   return scene;

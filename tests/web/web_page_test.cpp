@@ -9,7 +9,8 @@
 // has loaded (exposed as the sequence is), plays (the shown frame changes),
 // offers its contact sheet and its video (or, without ffmpeg, says why not)
 // and is listed done.  "Reference balls" puts the three balls in the request,
-// in front of the camera.  Skipped (with the command that installs them) when
+// in front of the camera; the Clouds box adds a layer only when a type is
+// chosen.  Skipped (with the command that installs them) when
 // Chromium or chromedriver is missing.
 #include <gtest/gtest.h>
 
@@ -217,6 +218,38 @@ TEST_F(WebPage, ReferenceBallsAreSentInFrontOfTheCameraAndRendered) {
   ASSERT_TRUE(driver.wait_until("return sentBodies.length === 2;", kPageTimeout)) << driver.log();
   EXPECT_FALSE(nlohmann::json::parse(driver.execute("return sentBodies[1];").get<std::string>()).contains("objects"));
 
+  const std::string log = driver.log();
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
+}
+
+// The Clouds box: off by default (the request has no "clouds"); a type, the
+// coverage slider and a wind speed and direction make one layer, the wind
+// sent the meteorological way.  Only the bodies are checked: the server
+// admits them, rendering them is the renderer's business.
+TEST_F(WebPage, CloudLayerIsSentOnlyWhenATypeIsChosen) {
+  WebDriver& driver = *driver_;
+  driver.execute("window.sentBodies = []; const send = window.fetch;"
+                 "window.fetch = (url, options) => { if (options && options.body) sentBodies.push(options.body);"
+                 "  return send(url, options); };");
+  EXPECT_EQ(driver.execute("return document.querySelector('#cloud-type').value;").get<std::string>(), "");
+  EXPECT_TRUE(driver.execute("return document.querySelector('#cloud-coverage').disabled;").get<bool>());
+  driver.type("#width", "16");
+  driver.type("#height", "8");
+  driver.click(driver.find("#submit"));
+  ASSERT_TRUE(driver.wait_until("return sentBodies.length === 1;", kPageTimeout)) << driver.log();
+  EXPECT_FALSE(nlohmann::json::parse(driver.execute("return sentBodies[0];").get<std::string>()).contains("clouds"));
+
+  set_value(driver, "#cloud-type", "stratocumulus");
+  EXPECT_FALSE(driver.execute("return document.querySelector('#cloud-coverage').disabled;").get<bool>());
+  EXPECT_EQ(driver.execute("return document.querySelector('#cloud-coverage').value;").get<std::string>(), "0.7");
+  set_value(driver, "#cloud-coverage", "0.25");
+  driver.type("#cloud-wind-speed", "8");
+  driver.click(driver.find("#submit"));
+  ASSERT_TRUE(driver.wait_until("return sentBodies.length === 2;", kPageTimeout)) << driver.log();
+  const nlohmann::json clouds = nlohmann::json::parse(driver.execute("return sentBodies[1];").get<std::string>())["clouds"];
+  EXPECT_EQ(clouds, nlohmann::json::parse(
+                        R"({"layers": [{"type": "stratocumulus", "coverage": 0.25, "wind": {"speed_m_s": 8, "from_deg": 270}}]})"))
+      << clouds.dump();
   const std::string log = driver.log();
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
 }

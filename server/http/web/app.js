@@ -208,6 +208,23 @@ function referenceBalls(yawDeg) {
   ];
 }
 
+// The cloud layer the Clouds controls describe, as the request's "clouds", or
+// null with type "none": the default request stays a clear sky, unchanged.
+// The type fills every field left out (docs/request-schema.md, clouds); the
+// wind is sent the meteorological way, only when a speed is given.
+function cloudLayers() {
+  const type = $("#cloud-type").value;
+  if (!type) return null;
+  const layer = { type, coverage: $("#cloud-coverage").valueAsNumber };
+  const speed = $("#cloud-wind-speed"), from = $("#cloud-wind-from");
+  if (speed.value !== "" || speed.validity.badInput) {
+    if (!Number.isFinite(speed.valueAsNumber)) throw { input: speed, message: "clouds.layers[0].wind.speed_m_s: must be a number" };
+    if (!Number.isFinite(from.valueAsNumber)) throw { input: from, message: "clouds.layers[0].wind.from_deg: must be a number" };
+    layer.wind = { speed_m_s: speed.valueAsNumber, from_deg: from.valueAsNumber };
+  }
+  return { layers: [layer] };
+}
+
 // The request body from the form, or throws {field input, message} for what
 // the browser can tell is wrong before sending (unreadable numbers, time zone).
 function readRequest() {
@@ -225,6 +242,8 @@ function readRequest() {
   }
   if (body.camera.projection === "equirectangular") delete body.camera.fov_deg;  // ignored there
   if (kind() === "render" && $("#reference-balls").checked) body.objects = referenceBalls(body.camera.yaw_deg ?? 0);
+  const clouds = cloudLayers();
+  if (clouds) body.clouds = clouds;
   const zone = $("#time-zone").value;
   const timed = (input) => {
     try { return isoWithOffset(input.value, zone); } catch (error) {
@@ -320,6 +339,9 @@ function updateFormMode() {
   document.body.dataset.kind = kind();
   $("#fov").disabled = $("#projection").value === "equirectangular";
   $("#ground-roughness").disabled = $("#ground-material").value === "";  // the default ground has none
+  const clear = $("#cloud-type").value === "";  // no layer: its controls do nothing
+  for (const id of ["#cloud-coverage", "#cloud-wind-speed", "#cloud-wind-from"]) $(id).disabled = clear;
+  $("#cloud-coverage-value").value = `${Math.round(100 * $("#cloud-coverage").valueAsNumber)} %`;
   try {
     $("#time-preview").value = isoWithOffset($("#time-local").value, $("#time-zone").value);
   } catch (error) {
@@ -333,6 +355,13 @@ $("#projection").addEventListener("change", () => {
   const width = $("#width").valueAsNumber;
   const aspect = { equirectangular: 1 / 2, fisheye: 1, perspective: 9 / 16 }[$("#projection").value];
   if (Number.isFinite(width) && aspect) $("#height").value = String(Math.max(1, Math.round(width * aspect)));
+});
+
+// A new cloud type starts from its own typical coverage (the defaults of
+// common/clouds/cloud_spec.cpp), which the slider then changes.
+$("#cloud-type").addEventListener("change", () => {
+  const coverage = { cumulus: 0.4, stratocumulus: 0.7, stratus: 1, cirrus: 0.5 }[$("#cloud-type").value];
+  if (coverage !== undefined) $("#cloud-coverage").value = String(coverage);
 });
 
 form.addEventListener("submit", submitForm);

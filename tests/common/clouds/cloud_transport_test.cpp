@@ -58,7 +58,8 @@ TEST(CloudTransport, DirectSunThroughAThinCloudIsBeerLambert) {
   const Ray up{scene->observer(), scene->sun().direction()};
   const double chord = distance_to_sphere(up, R + testing::kSlabTop_m) - distance_to_sphere(up, R + testing::kSlabBottom_m);
   const double exact = std::exp(-tau / (testing::kSlabTop_m - testing::kSlabBottom_m) * chord);
-  EXPECT_NEAR(exact, std::exp(-tau / std::cos(zenith * kDegToRad)), 1e-4);
+  // (The shell's curvature lengthens the chord by ~tan^2(zenith) h / R over the plane's.)
+  EXPECT_NEAR(exact, std::exp(-tau / std::cos(zenith * kDegToRad)), 5e-4);
   EXPECT_NEAR(mean, exact, 4.0 * se);
   EXPECT_LT(se, 0.01);
 }
@@ -73,7 +74,8 @@ TEST(CloudTransport, ConservativeSlabReflectsPlusTransmitsEverything) {
       const CloudOptics optics = forward ? hg_cloud(0.85) : isotropic_cloud();
       const auto above = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabTop_m + 1.0);
       const auto below = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabBottom_m - 1.0);
-      const int n = 6000;
+      // The forward peak makes the sun's NEE noisier: more paths.
+      const int n = forward ? 24000 : 6000;
       const testing::FluxEstimate R = testing::hemisphere_flux_ratio(*above, false, n, 11);
       const testing::FluxEstimate T = testing::hemisphere_flux_ratio(*below, true, n, 12);
       const double direct = std::exp(-tau / mu0);

@@ -1,0 +1,131 @@
+// The path tracer at the clouds' extremes, on uniform slabs over a black
+// ground in an airless sky: a cloud of optical depth 500, the camera inside
+// a cloud, a high cloud lit from beneath after sunset, cirrus seen from
+// geostationary orbit.  Every estimate is finite and >= 0, no path reaches
+// the depth cap, and the cost per path (tentative collisions, shadow rays
+// included) stays bounded; the figures are printed for the experiments log.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "common/core/constants.h"
+#include "tests/support/cloud_slab_scene.h"
+
+namespace skyfarm {
+namespace {
+
+CloudOptics hg_cloud(double g) {
+  CloudOptics o;
+  o.albedo = 1.0;
+  o.phase = PhaseFunction::henyey_greenstein(g);
+  o.asymmetry = g;
+  return o;
+}
+
+struct Cost {
+  testing::FluxEstimate flux;
+  double collisions_per_path = 0.0;
+};
+
+Cost measure(const Scene& scene, bool looking_up, int n, std::uint64_t seed) {
+  Cost c;
+  c.flux = testing::hemisphere_flux_ratio(scene, looking_up, n, seed);
+  c.collisions_per_path = static_cast<double>(c.flux.counters.collisions) / n;
+  return c;
+}
+
+void expect_sane(const Cost& c, double max_collisions_per_path) {
+  EXPECT_EQ(c.flux.counters.nonfinite, 0u);
+  EXPECT_EQ(c.flux.counters.depth_limit, 0u);
+  EXPECT_TRUE(std::isfinite(c.flux.mean));
+  EXPECT_GE(c.flux.mean, 0.0);
+  EXPECT_LT(c.collisions_per_path, max_collisions_per_path);
+}
+
+// tau 500 (a cumulonimbus' optical depth), g 0.85.  Seen from above nearly
+// everything is reflected (diffusion theory: R = 1 - T, T ~ 1 / (0.75 tau
+// (1 - g) + 1.42) ~ 0.018 for a conservative slab; Bohren 1987, "Multiple
+// scattering of light and some of its observable consequences", Am. J.
+// Phys. 55, 524).  The transmitted light needs walks of ~(tau (1 - g))^2 /
+// (1 - g) ~ 40 000 scatterings, beyond the depth roulette's start (10 000):
+// the estimate from below is unbiased but its mean lives in a heavy tail, and
+// at a few thousand paths it reads low.  What must hold: finite, >= 0, no
+// hard-cap hit, bounded collisions per path, and the reflectance.
+TEST(CloudExtremes, OpticalDepth500IsFiniteAndBounded) {
+  const auto above = testing::cloud_slab_scene(500.0, hg_cloud(0.85), 30.0, testing::kSlabTop_m + 1.0);
+  const auto below = testing::cloud_slab_scene(500.0, hg_cloud(0.85), 30.0, testing::kSlabBottom_m - 1.0);
+  const Cost R = measure(*above, false, 3000, 21);
+  const Cost T = measure(*below, true, 1000, 22);
+  std::printf("tau 500: R %.4f +- %.4f (%.0f collisions/path), T %.5f +- %.5f (%.0f collisions/path)\n",
+              R.flux.mean, R.flux.se, R.collisions_per_path, T.flux.mean, T.flux.se, T.collisions_per_path);
+  // Expected cost <= depth_rr_start + 1/(1 - survival) scatterings, each
+  // with a shadow ray that roulette ends in a few collisions.
+  expect_sane(R, 5000.0);
+  expect_sane(T, 5000.0);
+  EXPECT_NEAR(R.flux.mean, 0.982, 4.0 * R.flux.se + 0.01);
+  EXPECT_LT(T.flux.mean, 0.05);
+}
+
+// The camera inside a cloud (fog): tau 50 over the 1 km slab, the camera in
+// its middle looking up.  Finite, > 0, bounded.
+TEST(CloudExtremes, CameraInsideACloudSeesFog) {
+  const auto inside = testing::cloud_slab_scene(50.0, hg_cloud(0.85), 40.0, 1500.0);
+  const Cost up = measure(*inside, true, 3000, 23);
+  const Cost down = measure(*inside, false, 3000, 24);
+  std::printf("inside tau 50: up %.4f (%.0f collisions/path), down %.4f (%.0f)\n", up.flux.mean,
+              up.collisions_per_path, down.flux.mean, down.collisions_per_path);
+  expect_sane(up, 20000.0);
+  expect_sane(down, 20000.0);
+  EXPECT_GT(up.flux.mean, 0.0);
+  EXPECT_GT(down.flux.mean, 0.0);
+  // More light above the camera than below it (the sun is above).
+  EXPECT_GT(up.flux.mean, down.flux.mean);
+}
+
+// A cloud at 8.5-9.5 km after sunset, the sun 2.5 deg below the horizon:
+// the planet's shadow covers the ground observer but not the cloud, which
+// the sun lights from beneath.  The base seen from the ground is bright.
+TEST(CloudExtremes, SunBelowTheHorizonLightsACloudFromBeneath) {
+  const auto scene = testing::cloud_slab_scene(5.0, hg_cloud(0.85), 92.5, 0.0, 8500.0, 9500.0);
+  const Cost up = measure(*scene, true, 4000, 25);
+  std::printf("cloud lit from beneath: %.4f +- %.4f of mu0 E0 (%.1f collisions/path)\n", up.flux.mean, up.flux.se,
+              up.collisions_per_path);
+  expect_sane(up, 2000.0);
+  EXPECT_GT(up.flux.mean, 4.0 * up.flux.se);
+}
+
+// Cirrus (tau 1, ice-like g 0.75) at 12-13 km seen from 36 000 km: rays
+// start 36 000 km out, cross the shell and meet the slab; the lit cloud
+// over a black ground reflects light back to space.
+TEST(CloudExtremes, CirrusFromGeostationaryOrbit) {
+  const auto scene = testing::cloud_slab_scene(1.0, hg_cloud(0.75), 30.0, 36.0e6, 12000.0, 13000.0);
+  const VolumePathIntegrator integrator(*scene);
+  SampledWavelengths wl;
+  wl.lambda_nm.fill(testing::kSlabLambda_nm);
+  wl.pdf.fill(1.0);
+  PathCounters counters;
+  double sum = 0.0;
+  const int n = 2000;
+  for (int i = 0; i < n; ++i) {
+    Sampler sampler(26, 0, static_cast<std::uint64_t>(i));
+    // Towards the sub-observer point, jittered over 1/100 rad (the disc is 0.18 rad across).
+    const double dx = 0.01 * (sampler.get(1u << 30) - 0.5), dy = 0.01 * (sampler.get((1u << 30) + 1) - 0.5);
+    const glm::dvec3 d = glm::normalize(glm::dvec3(dx, dy, -1.0));
+    const double L = integrator.radiance(Ray{scene->observer(), d}, wl, sampler, &counters)[0];
+    EXPECT_TRUE(std::isfinite(L));
+    EXPECT_GE(L, 0.0);
+    sum += L;
+  }
+  EXPECT_EQ(counters.nonfinite, 0u);
+  EXPECT_EQ(counters.depth_limit, 0u);
+  const double mean = sum / n * kPi / (std::cos(30.0 * kDegToRad) * scene->sun().irradiance(testing::kSlabLambda_nm));
+  std::printf("cirrus from 36 000 km: pi L / (mu0 E0) = %.4f (%.1f collisions/path)\n", mean,
+              static_cast<double>(counters.collisions) / n);
+  // Single-scattering bound below, conservation above: 0 < R < 1.
+  EXPECT_GT(mean, 0.01);
+  EXPECT_LT(mean, 1.0);
+}
+
+}  // namespace
+}  // namespace skyfarm

@@ -1,0 +1,146 @@
+// The path tracer in a plane-parallel cloud slab against an independent
+// solution of the same radiative transfer: the adding-doubling solver
+// (tests/support/adding_doubling.h, itself checked against published
+// results).  Flux reflectance R from an observer just above the slab looking
+// down, diffuse transmittance from one just below looking up
+// (tests/support/cloud_slab_scene.h); the point sun's direct beam is never
+// seen by camera rays, so the solver's diffuse part is compared (for the Mie
+// phase, delta-M puts part of the forward peak in the solver's direct beam;
+// its diffuse is the total minus the true exp(-tau/mu0), DISORT's way).
+//
+// Tolerance: 4 standard errors + the solver's error (48 streams against 96:
+// < 1e-3 for these cases) + the shell against the plane (~1e-4).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
+#include "common/clouds/cloud_optics.h"
+#include "common/core/constants.h"
+#include "common/data/csv_table.h"
+#include "tests/support/adding_doubling.h"
+#include "tests/support/cloud_slab_scene.h"
+
+namespace skyfarm {
+namespace {
+
+constexpr double kSolverError = 1e-3 + 1e-4;
+
+CloudOptics isotropic_optics() {
+  CloudOptics o;
+  o.albedo = 1.0;
+  o.phase = PhaseFunction::isotropic();
+  return o;
+}
+
+struct OracleCase {
+  const char* name;
+  CloudOptics optics;
+  double tau, zenith_deg;
+  int paths;
+  double max_se = 0.02;  // the estimate must be sharp enough to mean something
+  // The default max_depth (10000) cuts ~0.2 % of the paths in a conservative
+  // tau = 100 slab (a transmitted random walk takes ~tau^2 scatterings): the
+  // thick cases lift it so that no path is cut.
+  int max_depth = IntegratorOptions{}.max_depth;
+};
+
+void compare_with_adding_doubling(const OracleCase& c) {
+  SCOPED_TRACE(::testing::Message() << c.name << " tau " << c.tau << " zenith " << c.zenith_deg);
+  const double mu0 = std::cos(c.zenith_deg * kDegToRad);
+  const testing::SlabFluxes ad = testing::adding_doubling_slab(c.tau, c.optics.albedo, c.optics.phase, mu0, 48);
+
+  const auto start = std::chrono::steady_clock::now();
+  const auto above = testing::cloud_slab_scene(c.tau, c.optics, c.zenith_deg, testing::kSlabTop_m + 1.0);
+  const auto below = testing::cloud_slab_scene(c.tau, c.optics, c.zenith_deg, testing::kSlabBottom_m - 1.0);
+  IntegratorOptions options;
+  options.max_depth = c.max_depth;
+  const testing::FluxEstimate R = testing::hemisphere_flux_ratio(*above, false, c.paths, 21, options);
+  const testing::FluxEstimate T = testing::hemisphere_flux_ratio(*below, true, c.paths, 22, options);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // The measurements the experiment log quotes (collisions per camera path,
+  // shadow rays' included).
+  std::printf("[oracle] %-10s tau %5.1f zenith %2.0f: R %.4f +- %.4f (AD %.4f)  T_diffuse %.4f +- %.4f (AD %.4f)"
+              "  collisions/path R %.0f T %.0f  %.1f s\n",
+              c.name, c.tau, c.zenith_deg, R.mean, R.se, ad.reflectance, T.mean, T.se, ad.diffuse_transmittance,
+              static_cast<double>(R.counters.collisions) / c.paths, static_cast<double>(T.counters.collisions) / c.paths,
+              seconds);
+
+  EXPECT_EQ(R.counters.nonfinite + T.counters.nonfinite, 0u);
+  EXPECT_EQ(R.counters.depth_limit + T.counters.depth_limit, 0u);
+  std::printf("[oracle]   paths cut by max_depth: %llu\n",
+              static_cast<unsigned long long>(R.counters.depth_limit + T.counters.depth_limit));
+  EXPECT_NEAR(R.mean, ad.reflectance, 4.0 * R.se + kSolverError);
+  EXPECT_NEAR(T.mean, ad.diffuse_transmittance, 4.0 * T.se + kSolverError);
+  EXPECT_LT(R.se, c.max_se);
+  EXPECT_LT(T.se, c.max_se);
+}
+
+CloudOptics hg_optics(double g) {
+  CloudOptics o;
+  o.albedo = 1.0;
+  o.phase = PhaseFunction::henyey_greenstein(g);
+  o.asymmetry = g;
+  return o;
+}
+
+TEST(CloudSlabOracle, IsotropicSlabMatchesAddingDoubling) {
+  compare_with_adding_doubling({"isotropic", isotropic_optics(), 1.0, 60.0, 8000});
+  compare_with_adding_doubling({"isotropic", isotropic_optics(), 10.0, 60.0, 20000});
+}
+
+// ~450 tentative collisions per path (shadow rays included).
+TEST(CloudSlabOracle, ThickIsotropicSlabMatchesAddingDoubling) {
+  compare_with_adding_doubling({"isotropic", isotropic_optics(), 100.0, 30.0, 4000, 0.02, 1000000});
+}
+
+TEST(CloudSlabOracle, ForwardScatteringSlabMatchesAddingDoubling) {
+  compare_with_adding_doubling({"hg 0.85", hg_optics(0.85), 1.0, 30.0, 20000});
+  compare_with_adding_doubling({"hg 0.85", hg_optics(0.85), 10.0, 30.0, 20000});
+}
+
+// The 10 um Mie table with its diffraction peak clipped at 3 degrees
+// (P <= P(3 deg) = 50.1, 4 pi normalised; g 0.864 -> 0.768): the same
+// tabulated-phase code paths, glory and fogbow kept, and a phase both
+// solvers take exactly as it is.  The full peak (P(0) = 7582) is below.
+CloudOptics clipped_mie_optics() {
+  const CsvTable csv = CsvTable::embedded("cloud_mie_phase_water_reff10um.csv");
+  const std::vector<double>& angles = csv.column("scattering_angle_deg");
+  std::vector<double> values = csv.column("phase_function_4pi_normalised");
+  double clip = 0.0;
+  for (std::size_t i = 0; i < angles.size(); ++i)
+    if (angles[i] == 3.0) clip = values[i];
+  for (double& v : values) v = std::min(v, clip);
+  CloudOptics o = cloud_optics(CloudParticle::kWater, 10.0);
+  o.phase = PhaseFunction::tabulated(angles, values);
+  o.asymmetry = o.phase.mean_cosine();
+  return o;
+}
+
+TEST(CloudSlabOracle, ClippedMieSlabMatchesAddingDoubling) {
+  const CloudOptics mie = clipped_mie_optics();
+  EXPECT_GT(mie.phase.eval(-1.0), 2.0 * mie.phase.eval(std::cos(170.0 * kDegToRad)));  // the glory is there
+  compare_with_adding_doubling({"mie<3deg", mie, 10.0, 30.0, 20000});
+  compare_with_adding_doubling({"mie<3deg", mie, 100.0, 60.0, 2000, 0.06, 1000000});
+}
+
+// The full Mie phase: its forward peak makes the point sun's next-event
+// estimate heavy-tailed.  A camera path meets the peak only where its
+// direction into a vertex is within ~1 degree of the sun's (a chance of
+// ~2e-5 per vertex), yet the diffraction peak carries about half of the
+// scattered light: the sample mean misses it most of the time and its
+// standard error understates the spread.  Measured (docs/experiments): tau 1
+// agrees with 200000 paths (R 0.052 +- 0.004 against 0.054, T 0.600 +- 0.035
+// against 0.631); at tau 100, 2000 paths give R 0.52 +- 0.04 against 0.92.
+// Hence only tau = 1 here, with the wide max_se this needs (an honest
+// statistical bound, not a loosened constant).
+TEST(CloudSlabOracle, ThinFullMieSlabMatchesAddingDoubling) {
+  compare_with_adding_doubling({"mie 10um", cloud_optics(CloudParticle::kWater, 10.0), 1.0, 30.0, 60000, 0.1});
+}
+
+}  // namespace
+}  // namespace skyfarm
