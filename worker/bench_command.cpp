@@ -16,6 +16,7 @@
 #include "common/render/parallel.h"
 #include "worker/bench_convergence.h"
 #include "worker/bench_efficiency.h"
+#include "worker/bench_lut_clouds.h"
 #include "worker/bench_lut_vs_path.h"
 #include "worker/bench_objects.h"
 #include "worker/cli_io.h"
@@ -120,6 +121,8 @@ int run_bench_command(const std::vector<std::string>& args) {
       return run_bench_convergence(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "lut-vs-path") {
       return run_bench_lut_vs_path(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
+    } else if (args[i] == "lut-clouds") {
+      return run_bench_lut_clouds(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "objects") {
       return run_bench_objects(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "efficiency") {
@@ -132,6 +135,7 @@ int run_bench_command(const std::vector<std::string>& args) {
                    "       skyfarm-worker bench efficiency [--samples N] [--sun-zenith DEG ...] [--shadow-scale S] "
                    "[--sunlit-segments]\n"
                    "       skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]\n"
+                   "       skyfarm-worker bench lut-clouds [--out DIR] [--spp N]\n"
                    "       skyfarm-worker bench objects [paths|mirror|all] [--repeat N] [--passes P] [--seeds K] "
                    "[--reference-passes R]\n";
       return 2;

@@ -221,6 +221,13 @@ void LutSky::march(const glm::dvec3& origin, const glm::dvec3& d, double t_max, 
     for (int b = 0; b < B; ++b) L[b] += sun_L_[static_cast<std::size_t>(b)] * T[b];
 }
 
+void LutSky::transmittance_to_top(double r, double mu, std::span<double> out) const {
+  check_size(out, tables_->grid.size(), "transmittance");
+  tables_->transmittance.to_top(r, std::clamp(mu, -1.0, 1.0), out.data());
+}
+
+double LutSky::planet_radius_m() const { return tables_->medium.planet_radius_m(); }
+
 void LutSky::sanitize(std::span<double> values) const {
   for (double& x : values)
     if (!(x >= 0.0) || !std::isfinite(x)) {

@@ -140,6 +140,13 @@ class LutSky {
   void raymarch_aerial_perspective(const glm::dvec3& origin_planet_centred, const glm::dvec3& dir, double distance_m,
                                    std::span<double> in_scattered, std::span<double> transmittance, int steps) const;
 
+  // The air's transmittance from radius r (m, planet-centred) along cosine mu
+  // (to the local zenith) to the top of the atmosphere, per bin: the
+  // transmittance table, 0 where the planet hides the direction.
+  void transmittance_to_top(double r, double mu, std::span<double> out) const;
+  double planet_radius_m() const;
+  const Sun& sun() const { return *sun_; }
+
   std::size_t memory_bytes() const;
   // Outputs replaced by 0 because they were negative or not finite (see above).
   std::uint64_t sanitized_values() const;

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/lut/cloud_march.h"
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
 #include "common/render/radiance_control.h"
@@ -34,13 +35,19 @@ TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const Rende
   if (plan_.lut)
     lut_ = std::make_shared<const LutSky>(LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),
                                                         plan_.lambda_min_nm, plan_.lambda_max_nm));
+  build_lut_clouds({});
 }
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
-                           std::shared_ptr<const LutSky> lut)
+                           std::shared_ptr<const LutSky> lut, const CloudMarchOptions& clouds)
     : scene_(scene), camera_(camera), plan_(plan), integrator_(scene), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())),
       lut_(std::move(lut)) {
   plan_.lut = true;
+  build_lut_clouds(clouds);
+}
+
+void TileRenderer::build_lut_clouds(const CloudMarchOptions& options) {
+  if (lut_ && scene_.clouds()) cloud_march_ = std::make_shared<const CloudMarch>(*lut_, *scene_.clouds(), options);
 }
 
 // One LUT sample per pixel: the centre's radiance, or for pixels that see
@@ -64,6 +71,7 @@ void TileRenderer::render_unit_lut(const WorkUnit& unit, FilmTile* film) const {
       if (!sees_sun) {
         if (!camera_.generate_ray(x, y, 0.5, 0.5, &ray)) continue;
         lut_->radiance(ray.d, L, true);
+        if (cloud_march_) cloud_march_->composite(ray.d, L);
       } else {
         std::fill(L.begin(), L.end(), 0.0);
         int count = 0;
@@ -71,6 +79,7 @@ void TileRenderer::render_unit_lut(const WorkUnit& unit, FilmTile* film) const {
           for (int i = 0; i < kSub; ++i) {
             if (!camera_.generate_ray(x, y, (i + 0.5) / kSub, (j + 0.5) / kSub, &ray)) continue;
             lut_->radiance(ray.d, L_sub, true);
+            if (cloud_march_) cloud_march_->composite(ray.d, L_sub);
             for (std::size_t k = 0; k < n; ++k) L[k] += L_sub[k];
             ++count;
           }
