@@ -97,7 +97,7 @@ TEST(FarmClouds, TheWindMovesTheCloudsBetweenFrames) {
     const std::string gust = "\"speed_m_s\": 15";
     if (!windy) r.replace(r.find(gust), gust.size(), "\"speed_m_s\": 0");
     if (later) r.replace(r.find("14:00:00Z"), 9, "14:10:00Z");
-    r.replace(r.find("\"seed\""), 0, "\"method\": \"lut\", ");
+    r.replace(r.rfind("\"seed\""), 0, "\"method\": \"lut\", ");
     const fs::path dir = fresh_dir(std::string(windy ? "windy" : "calm") + (later ? "_later" : ""));
     EXPECT_FALSE(testing::local_render_exr(r, dir).empty());
     return dir / "local.exr";
