@@ -67,7 +67,9 @@
 // version 1 worker would ignore it and render the wrong samples; 3 since the
 // pooled ground of an observer at 0 m, render_plan.h: a version 2 worker
 // would trace every sample of those pixels; 4 since ASSET_GET / ASSET: a
-// version 3 worker would fail every unit whose request has objects); the
+// version 3 worker would fail every unit whose request has objects; 5 since
+// clouds: a version 4 worker would fail every unit whose request has clouds,
+// and cannot fetch cloud volumes); the
 // server refuses another version with a fatal DISCONNECT.  CURVE changed no
 // message (version 3 then): an older worker fails the handshake (NULL
 // mechanism) before any READY, which is the refusal it gets.  Decoding is
@@ -90,7 +92,7 @@
 
 namespace skyfarm::api {
 
-inline constexpr int kProtocolVersion = 4;
+inline constexpr int kProtocolVersion = 5;
 // The READY capability "probe" of a worker that runs probe units.
 inline constexpr int kProbeUnitsVersion = 1;
 

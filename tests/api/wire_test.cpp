@@ -64,7 +64,8 @@ TEST(WireTest, AssetMessagesCarryTheFileOrAReason) {
   EXPECT_EQ(get[0], "ASSET_GET");
   EXPECT_EQ(command_from_name("ASSET_GET"), Command::kAssetGet);
   EXPECT_EQ(command_from_name("ASSET"), Command::kAsset);
-  static_assert(kProtocolVersion == 4, "ASSET_GET / ASSET are version 4");
+  static_assert(kProtocolVersion >= 4, "ASSET_GET / ASSET are version 4");
+  static_assert(kProtocolVersion == 5, "clouds are version 5");
   static_assert(kMaxAssetBytes == 168'000'016u, "the file of a mesh at the default MeshLimits");
 }
 
