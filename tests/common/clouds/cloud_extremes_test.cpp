@@ -108,6 +108,35 @@ TEST(CloudExtremes, SunBelowTheHorizonLightsCloudsFromBeneath) {
   EXPECT_GT(up.flux.mean, 4.0 * up.flux.se);
 }
 
+// Coverage 0 and 1 of a stratus layer at 1-2 km (tau 10 where full) over a
+// black ground in an airless sky, point sun: with no cloud the sky seen
+// from the ground is black (the point sun's direct beam is not a camera
+// ray's to meet), with an overcast it is the cloud base's diffuse light.
+TEST(CloudExtremes, CoverageZeroIsClearAndOneIsOvercast) {
+  auto scene_with = [](double coverage) {
+    auto scene = std::make_unique<Scene>(Scene::from_specs(testing::thin_hg_layer(1e-15, 10000.0, 0.0),
+                                                           testing::sun_spec(40.0, 0.0, 0.0), Location{},
+                                                           std::nullopt, 500.0, 600.0));
+    CloudLayerSpec layer = cloud_layer_preset(CloudType::kStratus);
+    layer.base_m = 1000.0;
+    layer.thickness_m = 1000.0;
+    layer.coverage = coverage;
+    layer.optical_depth = 10.0;
+    scene->set_clouds(std::make_shared<SceneClouds>(std::vector<std::shared_ptr<const CloudField>>{
+        std::make_shared<CloudLayer>(layer, scene->atmosphere().planet_radius_m(), glm::dvec3(0.0))}));
+    return scene;
+  };
+  const Cost clear = measure(*scene_with(0.0), true, 2000, 27);
+  const Cost overcast = measure(*scene_with(1.0), true, 4000, 28);
+  std::printf("coverage 0: %.5f (%.2f collisions/path); coverage 1: %.4f +- %.4f (%.0f collisions/path)\n",
+              clear.flux.mean, clear.collisions_per_path, overcast.flux.mean, overcast.flux.se,
+              overcast.collisions_per_path);
+  expect_sane(clear, 4.0);  // the near-empty air's own tracking: ~2 per path
+  expect_sane(overcast, 2000.0);
+  EXPECT_EQ(clear.flux.mean, 0.0);
+  EXPECT_GT(overcast.flux.mean, 4.0 * overcast.flux.se);
+}
+
 // Cirrus (tau 1, ice-like g 0.75) at 12-13 km seen from 36 000 km: rays
 // start 36 000 km out, cross the shell and meet the slab; the lit cloud
 // over a black ground reflects light back to space.
