@@ -602,8 +602,9 @@ bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::
 // sun's direction, the clouds' first collision along it (delta tracking in
 // the clouds, as the path's segments sample theirs), the air's transmittance
 // up to it (ratio tracking: its spectral-MIS ratios r_l join the vertex's,
-// as a shadow ray's do in sample_sun) and the NEE there, weighed by
-// p / (p + q) * p_wo / q... that is beta p(wo.wi) / (p(wo.wi) + q(wi)).
+// as a shadow ray's do in sample_sun) and the NEE there: the path's
+// throughput times p(wo.wi) / q(wi) (the direction's importance weight)
+// times the balance weight q / (p + q), that is beta p / (p + q).
 SampledSpectrum VolumePathIntegrator::sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& p,
                                                         const glm::dvec3& wo, const PathState& st,
                                                         const PathContext& c) const {
