@@ -31,7 +31,13 @@
 // transmittances multiply).  A cloud collision scatters by the cloud's
 // phase function with sun NEE (scatter_in_cloud); every shadow ray
 // multiplies in the clouds' ratio-tracked transmittance.  Grey clouds leave
-// the spectral-MIS ratios unchanged.  A clear sky takes none of this code.
+// the spectral-MIS ratios unchanged.  Each cloud vertex also estimates the
+// next cloud vertex's NEE along a direction drawn from the phase function
+// about the sun's (the sun lobe, IntegratorOptions::cloud_sun_lobe; Buras &
+// Mayer 2011), balanced against the path's own next vertex: a cloud's
+// diffraction peak (half its scattered light within ~1 degree) is then met
+// without the path having to arrive along the sun's direction by chance.
+// A clear sky takes none of this code.
 //
 // Options:
 //   max_depth         hard cap on scattering events (a cost bound; hits are
