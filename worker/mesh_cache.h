@@ -19,16 +19,12 @@
 // Threads: mesh() may be called from every render thread; an asset wanted by
 // several at once is loaded (and fetched) once, the others wait for it.
 // Errors are not remembered: the next call tries again.
+//
+// The machinery (memory, disk, fetch, the hash check) is worker/decoded_asset_cache.h.
 #pragma once
-#include <atomic>
 #include <cstddef>
-#include <cstdint>
 #include <functional>
-#include <future>
-#include <list>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -36,6 +32,7 @@
 #include "common/assets/mesh_file.h"
 #include "common/assets/mesh_source.h"
 #include "worker/asset_cache.h"
+#include "worker/decoded_asset_cache.h"
 
 namespace skyfarm {
 
@@ -46,12 +43,7 @@ class AssetUnavailable : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-struct MeshCacheStats {
-  std::uint64_t memory_hits = 0;
-  std::uint64_t disk_hits = 0;
-  std::uint64_t fetches = 0;   // calls of fetch
-  std::uint64_t rejected = 0;  // files that did not hash to their id or did not decode
-};
+using MeshCacheStats = AssetCacheStats;
 
 class MeshCache : public assets::MeshSource {
  public:
@@ -65,21 +57,7 @@ class MeshCache : public assets::MeshSource {
   MeshCacheStats stats() const;
 
  private:
-  using Mesh = std::shared_ptr<const assets::TriangleMesh>;
-  Mesh load(const std::string& id) const;
-  // The mesh in `bytes`, or null with *why set.
-  Mesh decode(const std::string& id, const std::string& bytes, std::string* why) const;
-  void remember(const std::string& id, const Mesh& mesh) const;
-
-  AssetDiskCache* disk_;
-  Fetch fetch_;
-  std::size_t memory_bytes_;
-  assets::MeshLimits limits_;
-  mutable std::mutex mutex_;
-  mutable std::list<std::pair<std::string, Mesh>> lru_;  // most recent first
-  mutable std::size_t held_bytes_ = 0;
-  mutable std::map<std::string, std::shared_future<Mesh>> loading_;
-  mutable std::atomic<std::uint64_t> memory_hits_{0}, disk_hits_{0}, fetches_{0}, rejected_{0};
+  DecodedAssetCache<assets::TriangleMesh> cache_;
 };
 
 // The bytes a decoded mesh holds (its positions and indices).

@@ -20,6 +20,19 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The file's bytes, or an error sentence naming it as `shown`.
+std::string read_file(const fs::path& path, const std::string& shown, std::string* bytes) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    std::error_code ec;
+    const bool exists = fs::exists(path, ec);
+    return "cannot read " + shown + ": " + (exists ? "permission denied or not a file" : "no such file");
+  }
+  bytes->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad()) return "cannot read " + shown + ": read error";
+  return "";
+}
+
 // The format named by the file's extension, else guessed from its bytes.
 std::optional<std::string> mesh_format(const fs::path& path, std::string_view bytes) {
   std::string ext = path.extension().string();
@@ -32,14 +45,8 @@ std::optional<std::string> mesh_format(const fs::path& path, std::string_view by
 // The imported file's id and mesh, or an error sentence.
 std::string import_file(const fs::path& path, const std::string& shown, std::string* id,
                         std::shared_ptr<const assets::TriangleMesh>* out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    const bool exists = fs::exists(path, ec);
-    return "cannot read " + shown + ": " + (exists ? "permission denied or not a file" : "no such file");
-  }
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return "cannot read " + shown + ": read error";
+  std::string bytes;
+  if (std::string error = read_file(path, shown, &bytes); !error.empty()) return error;
   const std::optional<std::string> format = mesh_format(path, bytes);
   if (!format) return "cannot import " + shown + ": not a mesh file this importer knows (obj, ply, stl, gltf, glb)";
   auto mesh = std::make_shared<assets::TriangleMesh>();
@@ -54,14 +61,8 @@ std::string import_file(const fs::path& path, const std::string& shown, std::str
 // The imported volume file's id and grid, or an error sentence.
 std::string import_volume_file(const fs::path& path, const std::string& shown, const std::string& grid_name,
                                std::string* id, std::shared_ptr<const assets::VolumeGrid>* out) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    std::error_code ec;
-    const bool exists = fs::exists(path, ec);
-    return "cannot read " + shown + ": " + (exists ? "permission denied or not a file" : "no such file");
-  }
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return "cannot read " + shown + ": read error";
+  std::string bytes;
+  if (std::string error = read_file(path, shown, &bytes); !error.empty()) return error;
   auto grid = std::make_shared<assets::VolumeGrid>();
   std::string error;
   if (assets::is_volume_file(bytes)) {
@@ -76,6 +77,40 @@ std::string import_volume_file(const fs::path& path, const std::string& shown, c
   *id = assets::asset_id_of(assets::encode_volume_file(*grid));
   *out = std::move(grid);
   return "";
+}
+
+// The entries of `entries` (the request's array `name`) that name an asset
+// by a non-empty string.  An asset id is loaded now by `load(id)`, so that a
+// missing one is named by its field; a path is replaced by the id that
+// `import(entry, path, &error)` returns, or its error is the field's.  What
+// is not a string is left to the request's parser.
+template <class Load, class Import>
+void resolve_asset_entries(nlohmann::json& entries, const std::string& name, Load load, Import import,
+                           std::vector<api::FieldError>* errors) {
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    nlohmann::json& entry = entries[i];
+    if (!entry.is_object()) continue;
+    const auto asset = entry.find("asset");
+    if (asset == entry.end() || !asset->is_string()) continue;
+    const std::string field = name + "[" + std::to_string(i) + "].asset";
+    const std::string value = asset->get<std::string>();
+    if (assets::is_asset_id(value)) {
+      try {
+        load(value);
+      } catch (const std::exception& e) {
+        errors->push_back({field, e.what(), ""});
+      }
+      continue;
+    }
+    if (value.empty()) continue;  // the parser says what an asset must be
+    std::string error;
+    const std::string id = import(entry, value, &error);
+    if (!error.empty()) {
+      errors->push_back({field, error, ""});
+      continue;
+    }
+    *asset = id;
+  }
 }
 
 }  // namespace
@@ -95,41 +130,27 @@ std::unique_ptr<LocalVolumeSource> resolve_request_volumes(nlohmann::json* reque
   if (volumes == clouds->end() || !volumes->is_array()) return source;
   std::vector<api::FieldError> errors;
   std::map<std::string, std::string> imported;  // path and grid -> id: a file named twice is read once
-  for (std::size_t i = 0; i < volumes->size(); ++i) {
-    nlohmann::json& volume = (*volumes)[i];
-    if (!volume.is_object()) continue;
-    const auto asset = volume.find("asset");
-    if (asset == volume.end() || !asset->is_string()) continue;
-    const std::string field = "clouds.volumes[" + std::to_string(i) + "].asset";
-    const std::string value = asset->get<std::string>();
-    if (assets::is_asset_id(value)) {
-      try {
-        (void)source->volume(value);  // loads it now, so a missing one is named by its field
-      } catch (const std::exception& e) {
-        errors.push_back({field, e.what(), ""});
-      }
-      continue;
-    }
-    if (value.empty()) continue;  // the parser says what an asset must be
-    const auto grid_field = volume.find("grid");
-    const std::string grid =
-        grid_field != volume.end() && grid_field->is_string() ? grid_field->get<std::string>() : std::string();
-    const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
-    const std::string key = path.string() + '\n' + grid;
-    std::string id;
-    if (const auto seen = imported.find(key); seen != imported.end()) {
-      id = seen->second;
-    } else {
-      std::shared_ptr<const assets::VolumeGrid> loaded;
-      if (std::string error = import_volume_file(path, value, grid, &id, &loaded); !error.empty()) {
-        errors.push_back({field, error, ""});
-        continue;
-      }
-      source->add(id, std::move(loaded));
-      imported.emplace(key, id);
-    }
-    *asset = id;
-  }
+  resolve_asset_entries(
+      *volumes, "clouds.volumes",
+      [&](const std::string& id) {
+        (void)source->volume(id);  // loads it now, so a missing one is named by its field
+      },
+      [&](const nlohmann::json& volume, const std::string& value, std::string* error) {
+        const auto grid_field = volume.find("grid");
+        const std::string grid =
+            grid_field != volume.end() && grid_field->is_string() ? grid_field->get<std::string>() : std::string();
+        const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
+        const std::string key = path.string() + '\n' + grid;
+        if (const auto seen = imported.find(key); seen != imported.end()) return seen->second;
+        std::string id;
+        std::shared_ptr<const assets::VolumeGrid> loaded;
+        *error = import_volume_file(path, value, grid, &id, &loaded);
+        if (!error->empty()) return std::string();
+        source->add(id, std::move(loaded));
+        imported.emplace(key, id);
+        return id;
+      },
+      &errors);
   if (!errors.empty()) throw api::ValidationError(std::move(errors));
   return source;
 }
@@ -147,37 +168,23 @@ std::unique_ptr<LocalMeshSource> resolve_request_assets(nlohmann::json* request,
   if (objects == request->end() || !objects->is_array()) return source;
   std::vector<api::FieldError> errors;
   std::map<std::string, std::string> imported;  // path -> id: a file named twice is read once
-  for (std::size_t i = 0; i < objects->size(); ++i) {
-    nlohmann::json& object = (*objects)[i];
-    if (!object.is_object()) continue;
-    const auto asset = object.find("asset");
-    if (asset == object.end() || !asset->is_string()) continue;
-    const std::string field = "objects[" + std::to_string(i) + "].asset";
-    const std::string value = asset->get<std::string>();
-    if (assets::is_asset_id(value)) {
-      try {
-        (void)source->mesh(value);  // loads it now, so a missing one is named by its field
-      } catch (const std::exception& e) {
-        errors.push_back({field, e.what(), ""});
-      }
-      continue;
-    }
-    if (value.empty()) continue;  // the parser says what an asset must be
-    const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
-    std::string id;
-    if (const auto seen = imported.find(path.string()); seen != imported.end()) {
-      id = seen->second;
-    } else {
-      std::shared_ptr<const assets::TriangleMesh> mesh;
-      if (std::string error = import_file(path, value, &id, &mesh); !error.empty()) {
-        errors.push_back({field, error, ""});
-        continue;
-      }
-      source->add(id, std::move(mesh));
-      imported.emplace(path.string(), id);
-    }
-    *asset = id;
-  }
+  resolve_asset_entries(
+      *objects, "objects",
+      [&](const std::string& id) {
+        (void)source->mesh(id);  // loads it now, so a missing one is named by its field
+      },
+      [&](const nlohmann::json&, const std::string& value, std::string* error) {
+        const fs::path path = fs::path(value).is_absolute() ? fs::path(value) : fs::path(base_dir) / value;
+        if (const auto seen = imported.find(path.string()); seen != imported.end()) return seen->second;
+        std::string id;
+        std::shared_ptr<const assets::TriangleMesh> mesh;
+        *error = import_file(path, value, &id, &mesh);
+        if (!error->empty()) return std::string();
+        source->add(id, std::move(mesh));
+        imported.emplace(path.string(), id);
+        return id;
+      },
+      &errors);
   if (!errors.empty()) throw api::ValidationError(std::move(errors));
   return source;
 }

@@ -16,22 +16,19 @@
 //
 // Threads: volume() may be called from every render thread; an asset wanted
 // by several at once is loaded (and fetched) once, the others wait for it.
+//
+// The machinery (memory, disk, fetch, the hash check) is worker/decoded_asset_cache.h.
 #pragma once
-#include <atomic>
 #include <cstddef>
-#include <cstdint>
 #include <functional>
-#include <future>
-#include <list>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <string_view>
 
 #include "common/assets/volume_file.h"
 #include "common/assets/volume_source.h"
 #include "worker/asset_cache.h"
+#include "worker/decoded_asset_cache.h"
 #include "worker/mesh_cache.h"
 
 namespace skyfarm {
@@ -48,20 +45,7 @@ class VolumeCache : public assets::VolumeSource {
   MeshCacheStats stats() const;
 
  private:
-  using Volume = std::shared_ptr<const assets::VolumeGrid>;
-  Volume load(const std::string& id) const;
-  Volume decode(const std::string& id, const std::string& bytes, std::string* why) const;
-  void remember(const std::string& id, const Volume& volume) const;
-
-  AssetDiskCache* disk_;
-  Fetch fetch_;
-  std::size_t memory_bytes_;
-  assets::VolumeLimits limits_;
-  mutable std::mutex mutex_;
-  mutable std::list<std::pair<std::string, Volume>> lru_;  // most recent first
-  mutable std::size_t held_bytes_ = 0;
-  mutable std::map<std::string, std::shared_future<Volume>> loading_;
-  mutable std::atomic<std::uint64_t> memory_hits_{0}, disk_hits_{0}, fetches_{0}, rejected_{0};
+  DecodedAssetCache<assets::VolumeGrid> cache_;
 };
 
 }  // namespace skyfarm

@@ -1,28 +1,14 @@
 #include "common/assets/mesh_file.h"
 
-#include <bit>
 #include <cmath>
 #include <cstring>
 
+#include "common/assets/binary_io.h"
+
 namespace skyfarm::assets {
 
-static_assert(std::endian::native == std::endian::little, "the mesh file is little-endian; add byte swaps here");
-
-namespace {
-
-template <class T>
-void append(std::string& out, const T& value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
-
-template <class T>
-T read_at(std::string_view bytes, std::size_t offset) {
-  T value;
-  std::memcpy(&value, bytes.data() + offset, sizeof value);
-  return value;
-}
-
-}  // namespace
+using binary_io::append;
+using binary_io::read_at;
 
 std::string encode_mesh_file(const TriangleMesh& mesh) {
   std::string out;

@@ -1,31 +1,16 @@
 #include "common/assets/volume_file.h"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstring>
 
+#include "common/assets/binary_io.h"
 #include "common/assets/mesh_file.h"
 
 namespace skyfarm::assets {
 
-static_assert(std::endian::native == std::endian::little, "the volume file is little-endian; add byte swaps here");
-
-namespace {
-
-template <class T>
-void append(std::string& out, const T& value) {
-  out.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
-
-template <class T>
-T read_at(std::string_view bytes, std::size_t offset) {
-  T value;
-  std::memcpy(&value, bytes.data() + offset, sizeof value);
-  return value;
-}
-
-}  // namespace
+using binary_io::append;
+using binary_io::read_at;
 
 std::string volume_size_error(std::uint64_t nx, std::uint64_t ny, std::uint64_t nz, const VolumeLimits& limits) {
   if (nx == 0 || ny == 0 || nz == 0) return "the volume has no voxels";

@@ -14,6 +14,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -68,6 +69,27 @@ bool read_whole_file(const std::string& path, std::string* bytes) {
   s << in.rdbuf();
   *bytes = std::move(s).str();
   return true;
+}
+
+int parse_import_args(const std::vector<std::string>& args, std::string_view command,
+                      const std::vector<ImportOption>& options, std::string* in, std::string* out) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    const auto option =
+        std::find_if(options.begin(), options.end(), [&](const ImportOption& o) { return o.name == a; });
+    if (option != options.end() && has_value) {
+      if (!option->set(args[++i])) return 2;
+    } else if (in->empty()) {
+      *in = a;
+    } else if (out->empty()) {
+      *out = a;
+    } else {
+      std::cerr << command << ": unexpected argument '" << a << "'\n";
+      return 2;
+    }
+  }
+  return 0;
 }
 
 bool write_whole_file(const std::string& path, std::string_view bytes) {

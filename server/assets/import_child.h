@@ -20,7 +20,10 @@
 // error (126, 127: it could not start).
 #pragma once
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
+#include <exception>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,5 +53,32 @@ ImportChildResult run_import_child(std::string_view bytes, const std::vector<std
 // For the child's side: the whole file, or false.
 bool read_whole_file(const std::string& path, std::string* bytes);
 bool write_whole_file(const std::string& path, std::string_view bytes);
+
+// For the child's side: an option that takes a value ("--grid NAME");
+// `set` returns false when the value is not one (a usage error).
+struct ImportOption {
+  std::string_view name;
+  std::function<bool(const std::string& value)> set;
+};
+
+// For the child's side: `args` as `options` in any order and the file names
+// IN and OUT (left empty when missing: the command says its usage).  An
+// option last on the line, without its value, counts as a file name.
+// Returns 0, or 2 after a usage error (a stray argument is named on stderr,
+// as `command`'s: "import-mesh").
+int parse_import_args(const std::vector<std::string>& args, std::string_view command,
+                      const std::vector<ImportOption>& options, std::string* in, std::string* out);
+
+// A count option's value: all of `s` a decimal number, else false.
+template <class Unsigned>
+bool parse_count(const std::string& s, Unsigned* value) {
+  try {
+    std::size_t used = 0;
+    *value = std::stoull(s, &used);
+    return used == s.size();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
 
 }  // namespace skyfarm::server

@@ -36,33 +36,16 @@ MeshImportResult run_mesh_import(std::string_view bytes, std::string_view format
 int run_import_mesh_command(const std::vector<std::string>& args) {
   std::string format, in, out;
   assets::MeshLimits limits;
-  auto number = [](const std::string& s, std::size_t* value) {
-    try {
-      std::size_t used = 0;
-      *value = std::stoull(s, &used);
-      return used == s.size();
-    } catch (const std::exception&) {
-      return false;
-    }
+  const std::vector<ImportOption> options = {
+      {"--format",
+       [&](const std::string& v) {
+         format = v;
+         return true;
+       }},
+      {"--max-triangles", [&](const std::string& v) { return parse_count(v, &limits.max_triangles); }},
+      {"--max-vertices", [&](const std::string& v) { return parse_count(v, &limits.max_vertices); }},
   };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (a == "--format" && has_value) {
-      format = args[++i];
-    } else if (a == "--max-triangles" && has_value) {
-      if (!number(args[++i], &limits.max_triangles)) return 2;
-    } else if (a == "--max-vertices" && has_value) {
-      if (!number(args[++i], &limits.max_vertices)) return 2;
-    } else if (in.empty()) {
-      in = a;
-    } else if (out.empty()) {
-      out = a;
-    } else {
-      std::cerr << "import-mesh: unexpected argument '" << a << "'\n";
-      return 2;
-    }
-  }
+  if (const int status = parse_import_args(args, "import-mesh", options, &in, &out); status != 0) return status;
   if (format.empty() || in.empty() || out.empty()) {
     std::cerr << "usage: import-mesh --format F [--max-triangles N] [--max-vertices N] IN OUT\n";
     return 2;

@@ -31,33 +31,16 @@ VolumeImportResult run_volume_import(std::string_view bytes, std::string_view gr
 int run_import_volume_command(const std::vector<std::string>& args) {
   std::string grid, in, out;
   assets::VolumeLimits limits;
-  auto number = [](const std::string& s, std::uint64_t* value) {
-    try {
-      std::size_t used = 0;
-      *value = std::stoull(s, &used);
-      return used == s.size();
-    } catch (const std::exception&) {
-      return false;
-    }
+  const std::vector<ImportOption> options = {
+      {"--grid",
+       [&](const std::string& v) {
+         grid = v;
+         return true;
+       }},
+      {"--max-voxels", [&](const std::string& v) { return parse_count(v, &limits.max_voxels); }},
+      {"--max-bytes", [&](const std::string& v) { return parse_count(v, &limits.max_bytes); }},
   };
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    const bool has_value = i + 1 < args.size();
-    if (a == "--grid" && has_value) {
-      grid = args[++i];
-    } else if (a == "--max-voxels" && has_value) {
-      if (!number(args[++i], &limits.max_voxels)) return 2;
-    } else if (a == "--max-bytes" && has_value) {
-      if (!number(args[++i], &limits.max_bytes)) return 2;
-    } else if (in.empty()) {
-      in = a;
-    } else if (out.empty()) {
-      out = a;
-    } else {
-      std::cerr << "import-volume: unexpected argument '" << a << "'\n";
-      return 2;
-    }
-  }
+  if (const int status = parse_import_args(args, "import-volume", options, &in, &out); status != 0) return status;
   if (in.empty() || out.empty()) {
     std::cerr << "usage: import-volume [--grid NAME] [--max-voxels N] [--max-bytes N] IN OUT\n";
     return 2;
