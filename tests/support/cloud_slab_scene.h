@@ -25,6 +25,22 @@
 
 namespace skyfarm::testing {
 
+// Grey cloud optics with a Henyey-Greenstein phase function of asymmetry g,
+// and with an isotropic one: the slabs' particles when the Mie phase is not the point.
+inline CloudOptics hg_cloud_optics(double g, double albedo = 1.0) {
+  CloudOptics o;
+  o.albedo = albedo;
+  o.phase = PhaseFunction::henyey_greenstein(g);
+  o.asymmetry = g;
+  return o;
+}
+inline CloudOptics isotropic_cloud_optics(double albedo = 1.0) {
+  CloudOptics o;
+  o.albedo = albedo;
+  o.phase = PhaseFunction::isotropic();
+  return o;
+}
+
 constexpr double kSlabBottom_m = 1000.0, kSlabTop_m = 2000.0, kSlabLambda_nm = 550.0;
 
 // The slab of optical depth tau (vertical) between kSlabBottom_m and

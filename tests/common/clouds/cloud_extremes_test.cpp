@@ -16,14 +16,6 @@
 namespace skyfarm {
 namespace {
 
-CloudOptics hg_cloud(double g) {
-  CloudOptics o;
-  o.albedo = 1.0;
-  o.phase = PhaseFunction::henyey_greenstein(g);
-  o.asymmetry = g;
-  return o;
-}
-
 struct Cost {
   testing::FluxEstimate flux;
   double collisions_per_path = 0.0;
@@ -54,8 +46,8 @@ void expect_sane(const Cost& c, double max_collisions_per_path) {
 // at a few thousand paths it reads low.  What must hold: finite, >= 0, no
 // hard-cap hit, bounded collisions per path, and the reflectance.
 TEST(CloudExtremes, OpticalDepth500IsFiniteAndBounded) {
-  const auto above = testing::cloud_slab_scene(500.0, hg_cloud(0.85), 30.0, testing::kSlabTop_m + 1.0);
-  const auto below = testing::cloud_slab_scene(500.0, hg_cloud(0.85), 30.0, testing::kSlabBottom_m - 1.0);
+  const auto above = testing::cloud_slab_scene(500.0, testing::hg_cloud_optics(0.85), 30.0, testing::kSlabTop_m + 1.0);
+  const auto below = testing::cloud_slab_scene(500.0, testing::hg_cloud_optics(0.85), 30.0, testing::kSlabBottom_m - 1.0);
   const Cost R = measure(*above, false, 3000, 21);
   const Cost T = measure(*below, true, 1000, 22);
   std::printf("tau 500: R %.4f +- %.4f (%.0f collisions/path), T %.5f +- %.5f (%.0f collisions/path)\n",
@@ -71,7 +63,7 @@ TEST(CloudExtremes, OpticalDepth500IsFiniteAndBounded) {
 // The camera inside a cloud (fog): tau 50 over the 1 km slab, the camera in
 // its middle looking up.  Finite, > 0, bounded.
 TEST(CloudExtremes, CameraInsideACloudSeesFog) {
-  const auto inside = testing::cloud_slab_scene(50.0, hg_cloud(0.85), 40.0, 1500.0);
+  const auto inside = testing::cloud_slab_scene(50.0, testing::hg_cloud_optics(0.85), 40.0, 1500.0);
   const Cost up = measure(*inside, true, 3000, 23);
   const Cost down = measure(*inside, false, 3000, 24);
   std::printf("inside tau 50: up %.4f (%.0f collisions/path), down %.4f (%.0f)\n", up.flux.mean,
@@ -141,7 +133,7 @@ TEST(CloudExtremes, CoverageZeroIsClearAndOneIsOvercast) {
 // start 36 000 km out, cross the shell and meet the slab; the lit cloud
 // over a black ground reflects light back to space.
 TEST(CloudExtremes, CirrusFromGeostationaryOrbit) {
-  const auto scene = testing::cloud_slab_scene(1.0, hg_cloud(0.75), 30.0, 36.0e6, 12000.0, 13000.0);
+  const auto scene = testing::cloud_slab_scene(1.0, testing::hg_cloud_optics(0.75), 30.0, 36.0e6, 12000.0, 13000.0);
   const VolumePathIntegrator integrator(*scene);
   SampledWavelengths wl;
   wl.lambda_nm.fill(testing::kSlabLambda_nm);

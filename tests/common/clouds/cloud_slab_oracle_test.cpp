@@ -80,14 +80,6 @@ void compare_with_adding_doubling(const OracleCase& c) {
   EXPECT_LT(T.se, c.max_se);
 }
 
-CloudOptics hg_optics(double g) {
-  CloudOptics o;
-  o.albedo = 1.0;
-  o.phase = PhaseFunction::henyey_greenstein(g);
-  o.asymmetry = g;
-  return o;
-}
-
 TEST(CloudSlabOracle, IsotropicSlabMatchesAddingDoubling) {
   compare_with_adding_doubling({"isotropic", isotropic_optics(), 1.0, 60.0, 8000});
   compare_with_adding_doubling({"isotropic", isotropic_optics(), 10.0, 60.0, 20000});
@@ -99,8 +91,8 @@ TEST(CloudSlabOracle, ThickIsotropicSlabMatchesAddingDoubling) {
 }
 
 TEST(CloudSlabOracle, ForwardScatteringSlabMatchesAddingDoubling) {
-  compare_with_adding_doubling({"hg 0.85", hg_optics(0.85), 1.0, 30.0, 20000});
-  compare_with_adding_doubling({"hg 0.85", hg_optics(0.85), 10.0, 30.0, 20000});
+  compare_with_adding_doubling({"hg 0.85", testing::hg_cloud_optics(0.85), 1.0, 30.0, 20000});
+  compare_with_adding_doubling({"hg 0.85", testing::hg_cloud_optics(0.85), 10.0, 30.0, 20000});
 }
 
 // The 10 um Mie table with its diffraction peak clipped at 3 degrees

@@ -51,20 +51,12 @@ void measure(const Case& c, double lobe_probability) {
   EXPECT_TRUE(std::isfinite(R.mean) && std::isfinite(T.mean));
 }
 
-CloudOptics hg_optics(double g) {
-  CloudOptics o;
-  o.albedo = 1.0;
-  o.phase = PhaseFunction::henyey_greenstein(g);
-  o.asymmetry = g;
-  return o;
-}
-
 TEST(CloudSunLobeMeasurement, DISABLED_SlabOracleCases) {
   const CloudOptics mie = cloud_optics(CloudParticle::kWater, 10.0);
   const Case cases[] = {{"mie 10um", mie, 1.0, 30.0, 20000},
                         {"mie 10um", mie, 10.0, 30.0, 8000},
                         {"mie 10um", mie, 100.0, 60.0, 1000},
-                        {"hg 0.85", hg_optics(0.85), 10.0, 30.0, 8000}};
+                        {"hg 0.85", testing::hg_cloud_optics(0.85), 10.0, 30.0, 8000}};
   std::printf("| phase | tau | sun zenith | lobe a | paths | R (PT) | R (AD) | T_diffuse (PT) | T_diffuse (AD) |"
               " collisions/path R / T | s R / T | 1/(SE^2 t) R / T |\n");
   for (const Case& c : cases)

@@ -16,28 +16,13 @@
 namespace skyfarm {
 namespace {
 
-CloudOptics isotropic_cloud(double albedo = 1.0) {
-  CloudOptics o;
-  o.albedo = albedo;
-  o.phase = PhaseFunction::isotropic();
-  return o;
-}
-
-CloudOptics hg_cloud(double g) {
-  CloudOptics o;
-  o.albedo = 1.0;
-  o.phase = PhaseFunction::henyey_greenstein(g);
-  o.asymmetry = g;
-  return o;
-}
-
 // --- Beer-Lambert: the transmittance towards the sun through a slab of
 // vertical optical depth tau is exp(-tau / mu0), the air's (1e-15 m^-1 over
 // 10 km) being 1 to 1e-11.  Ratio tracking with roulette is unbiased: its
 // mean over many shadow rays matches within 4 standard errors.
 TEST(CloudTransport, DirectSunThroughAThinCloudIsBeerLambert) {
   const double tau = 0.7, zenith = 50.0;
-  const auto scene = testing::cloud_slab_scene(tau, isotropic_cloud(), zenith, 0.0);
+  const auto scene = testing::cloud_slab_scene(tau, testing::isotropic_cloud_optics(), zenith, 0.0);
   const VolumePathIntegrator integrator(*scene);
   SampledWavelengths wl;
   wl.lambda_nm.fill(550.0);
@@ -71,7 +56,7 @@ TEST(CloudTransport, ConservativeSlabReflectsPlusTransmitsEverything) {
   for (const double tau : {1.0, 10.0}) {
     for (const bool forward : {false, true}) {
       SCOPED_TRACE(::testing::Message() << "tau " << tau << (forward ? " HG 0.85" : " isotropic"));
-      const CloudOptics optics = forward ? hg_cloud(0.85) : isotropic_cloud();
+      const CloudOptics optics = forward ? testing::hg_cloud_optics(0.85) : testing::isotropic_cloud_optics();
       const auto above = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabTop_m + 1.0);
       const auto below = testing::cloud_slab_scene(tau, optics, zenith, testing::kSlabBottom_m - 1.0);
       // The forward peak makes the sun's NEE noisier: more paths.
