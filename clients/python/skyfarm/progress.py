@@ -34,7 +34,7 @@ def describe(status):
             parts.append("making the outputs")
     else:
         spp = _number(progress.get("samples_per_pixel"))
-        if spp is not None:
+        if spp is not None and status.get("method") != "lut":  # one look-up per pixel, no samples
             parts.append(("%g spp" % spp))
         error = _number((status.get("error") or {}).get("estimated_relative_rms"))
         if error is not None:
