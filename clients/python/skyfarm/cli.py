@@ -6,8 +6,9 @@
   --token TOKEN  bearer token of a server run with --token (default $SKYFARM_TOKEN)
   --timeout S    seconds one HTTP exchange may take (default 60)
 
-Commands: render, status, cancel, renders, sky, envmap, probe, timelapse,
-timelapses, workers, assets (``skyfarm COMMAND --help``).  JSON answers are
+Commands: render (= submit, wait, download), submit, wait, download, status,
+cancel, renders, sky, envmap, probe, timelapse, timelapses, workers, assets
+(``skyfarm COMMAND --help``).  JSON answers are
 printed on stdout; progress and messages go to stderr.  Exit status: 0 done,
 1 an error answer of the server (one line per invalid field, naming it) or
 no server, 2 bad usage, 3 a render or timelapse that failed or was
@@ -57,41 +58,68 @@ def _progress(args, label=None):
 
 # --- commands ----------------------------------------------------------------
 
+def _wait(render, args):
+    bar = _progress(args, label=render.id)
+    try:
+        return render.wait(progress=bar, timeout=args.wait_timeout)
+    finally:
+        if bar is not None:
+            bar.close()
+
+
+def _download(render, args):
+    if args.output:
+        _note("wrote " + render.download(args.output))
+    if args.png:
+        _note("wrote " + render.download(args.png, "png"))
+
+
 def cmd_render(client, args):
     if not args.output and not args.png:
         raise SystemExit("skyfarm render: error: give -o FILE.exr and/or --png FILE.png")
     render = client.submit(args.request, idempotency_key=args.idempotency_key)
     how = " (from the result cache)" if render.from_cache else (" (submitted before)" if render.created is False else "")
     _note("render %s%s: %s%s" % (render.id, how, client.url, render.path))
-    bar = _progress(args, label=render.id)
-    try:
-        status = render.wait(progress=bar, timeout=args.wait_timeout)
-    finally:
-        if bar is not None:
-            bar.close()
-    if args.output:
-        _note("wrote " + render.download(args.output))
-    if args.png:
-        _note("wrote " + render.download(args.png, "png"))
+    status = _wait(render, args)
+    _download(render, args)
     if args.json:
         _print_json(status)
     return 0
 
 
+def cmd_submit(client, args):
+    _print_json(client.submit(args.request, idempotency_key=args.idempotency_key).answer)
+    return 0
+
+
+def cmd_wait(client, args):
+    status = _wait(client.get_render(args.id), args)
+    if args.json:
+        _print_json(status)
+    return 0
+
+
+def cmd_download(client, args):
+    if not args.output and not args.png:
+        raise SystemExit("skyfarm download: error: give -o FILE.exr and/or --png FILE.png")
+    _download(client.get_render(args.id), args)
+    return 0
+
+
 def cmd_status(client, args):
-    handle = client.timelapse_of(args.id) if args.timelapse else client.render(args.id)
+    handle = client.get_timelapse(args.id) if args.timelapse else client.get_render(args.id)
     _print_json(handle.status())
     return 0
 
 
 def cmd_cancel(client, args):
     if args.timelapse:
-        _print_json(client.timelapse_of(args.id).cancel())
+        _print_json(client.get_timelapse(args.id).cancel())
     elif args.purge:
-        client.render(args.id).cancel(purge=True)
+        client.get_render(args.id).cancel(purge=True)
         _note("purged render " + args.id)
     else:
-        _print_json(client.render(args.id).cancel())
+        _print_json(client.get_render(args.id).cancel())
     return 0
 
 
@@ -208,10 +236,11 @@ def build_parser():
         p.set_defaults(handler=handler)
         return p
 
-    def waits(p):
+    def waits(p, submits=True):
         p.add_argument("--quiet", action="store_true", help="no progress bar")
         p.add_argument("--json", action="store_true", help="print the final status document on stdout")
-        p.add_argument("--idempotency-key", metavar="KEY", help="makes a retried submission answer the same job")
+        if submits:
+            p.add_argument("--idempotency-key", metavar="KEY", help="makes a retried submission answer the same job")
         p.add_argument("--wait-timeout", type=float, metavar="S", help="give up waiting after S seconds")
 
     p = command("render", cmd_render, "submit a render request, show its progress, download the image")
@@ -219,6 +248,19 @@ def build_parser():
     p.add_argument("-o", "--output", metavar="FILE", help="the image (.exr, or .png by its name)")
     p.add_argument("--png", metavar="FILE", help="also the PNG")
     waits(p)
+
+    p = command("submit", cmd_submit, "submit a render request; print the answer (id, links) and return")
+    p.add_argument("request", help="the request's JSON file")
+    p.add_argument("--idempotency-key", metavar="KEY", help="makes a retried submission answer the same job")
+
+    p = command("wait", cmd_wait, "wait for a render to end, showing its progress")
+    p.add_argument("id")
+    waits(p, submits=False)
+
+    p = command("download", cmd_download, "download a render's image (progressive until it is done)")
+    p.add_argument("id")
+    p.add_argument("-o", "--output", metavar="FILE", help="the image (.exr, or .png by its name)")
+    p.add_argument("--png", metavar="FILE", help="also the PNG")
 
     for name, handler, what in (("status", cmd_status, "print a render's status document"),
                                 ("cancel", cmd_cancel, "cancel a render (or --purge: delete it)")):

@@ -20,18 +20,19 @@ import os
 
 from .render import Render
 from .timelapse import Timelapse
-from .transport import Transport
+from .transport import Transport, json_default
 
 DEFAULT_URL = "http://127.0.0.1:8080"
 _PROBE_TIMEOUT_S = 180.0
 
 
 def request_body(request):
-    """The JSON body of a request given as a dict (serialised), bytes or a
+    """The JSON body of a request given as a dict (serialised; datetimes as
+    ISO 8601), bytes or a
     str of JSON text (sent as they are), or a file's path (its bytes, so the
     server's errors speak of the file as written)."""
     if isinstance(request, dict):
-        return json.dumps(request).encode("utf-8")
+        return json.dumps(request, default=json_default).encode("utf-8")
     if isinstance(request, bytes):
         return request
     if isinstance(request, str) and request.lstrip().startswith("{"):
@@ -108,7 +109,7 @@ class Client:
         answer = self._transport.json("POST", "/v1/renders", None, request_body(request), headers)
         return Render(self, answer["id"], answer)
 
-    def render(self, render_id):
+    def get_render(self, render_id):
         """The ``Render`` of an existing id (no request is made)."""
         return Render(self, render_id)
 
@@ -126,7 +127,7 @@ class Client:
         answer = self._transport.json("POST", "/v1/timelapses", None, request_body(request), headers)
         return Timelapse(self, answer["id"], answer)
 
-    def timelapse_of(self, timelapse_id):
+    def get_timelapse(self, timelapse_id):
         """The ``Timelapse`` of an existing id (no request is made)."""
         return Timelapse(self, timelapse_id)
 

@@ -1,6 +1,6 @@
 """A render on the farm: its status, its events, its images, cancelling it.
 
-``Client.submit`` answers a ``Render``; ``Client.render(id)`` makes one for
+``Client.submit`` answers a ``Render``; ``Client.get_render(id)`` makes one for
 an existing id.  ``wait`` follows ``GET /v1/renders/{id}/events`` (Server-
 Sent Events, each frame's data the status document): a dropped connection
 is resumed with ``Last-Event-ID`` so no event is lost or repeated, and a

@@ -9,6 +9,7 @@ target and are renamed into place, so a broken transfer never leaves a
 truncated image under the asked name.
 """
 
+import datetime
 import json
 import os
 import socket
@@ -24,10 +25,18 @@ from .errors import TransportError, problem_error
 _CHUNK = 1 << 16
 
 
+def json_default(value):
+    """JSON for what ``json`` cannot write: a datetime is ISO 8601 (the
+    server wants a UTC offset: give it an aware datetime)."""
+    if isinstance(value, (datetime.datetime, datetime.date)):
+        return value.isoformat()
+    raise TypeError("%s is not JSON serialisable" % type(value).__name__)
+
+
 def query_string(query):
     """``?a=1&b=true`` of a dict; None values are left out, booleans are
-    ``true``/``false``, lists repeat the name.  ``+`` (a time's UTC offset)
-    is sent as ``%2B``."""
+    ``true``/``false``, datetimes ISO 8601, lists repeat the name.  ``+``
+    (a time's UTC offset) is sent as ``%2B``."""
     pairs = []
     for name, value in (query or {}).items():
         values = value if isinstance(value, (list, tuple)) else [value]
@@ -36,6 +45,8 @@ def query_string(query):
                 continue
             if isinstance(v, bool):
                 v = "true" if v else "false"
+            elif isinstance(v, (datetime.datetime, datetime.date)):
+                v = v.isoformat()
             pairs.append((name, str(v)))
     return "?" + urllib.parse.urlencode(pairs) if pairs else ""
 
@@ -107,7 +118,9 @@ class Transport:
         body = None
         all_headers = dict(headers or {})
         if document is not None:
-            body = document if isinstance(document, bytes) else json.dumps(document).encode("utf-8")
+            if not isinstance(document, bytes):
+                document = json.dumps(document, default=json_default).encode("utf-8")
+            body = document
             all_headers["Content-Type"] = "application/json"
         return self.call(method, path, query, body, all_headers, timeout).json()
 

@@ -81,6 +81,23 @@ class CliTest(unittest.TestCase):
         self.assertEqual(code, 0)
         self.assertEqual(json.loads(out)["id"], status["id"])
 
+    def test_submit_wait_download(self):
+        request = self.write_request({"sun": {"zenith_deg": 35, "azimuth_deg": 90}, "method": "lut",
+                                      "camera": {"projection": "fisheye", "width": 8, "height": 8}})
+        code, out, err = skyfarm_cli("submit", request)
+        self.assertEqual(code, 0, err)
+        answer = json.loads(out)
+        self.assertEqual(answer["links"]["self"], "/v1/renders/" + answer["id"])
+        code, out, err = skyfarm_cli("wait", answer["id"], "--json", "--quiet")
+        self.assertEqual(code, 0, err)
+        self.assertEqual(json.loads(out)["state"], "done")
+        self.assertEqual(err, "")
+        png = os.path.join(self.folder, "fisheye.png")
+        code, _, err = skyfarm_cli("download", answer["id"], "--png", png)
+        self.assertEqual(code, 0, err)
+        with open(png, "rb") as f:
+            self.assertEqual(png_size(f.read()), (8, 8))
+
     def test_invalid_request_exits_naming_the_field(self):
         request = self.write_request({"sun": {"zenith_deg": 30, "azimuth_deg": 180},
                                       "camera": {"projection": "perspective", "fov_deg": 200}})

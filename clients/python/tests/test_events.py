@@ -117,7 +117,7 @@ class WaitTest(unittest.TestCase):
             statuses=[status("running", 0.5, 8, 0.2)])
         self.addCleanup(farm.close)
         seen = []
-        final = skyfarm.Client(farm.url).render("r1").wait(progress=seen.append)
+        final = skyfarm.Client(farm.url).get_render("r1").wait(progress=seen.append)
         self.assertEqual(final["state"], "done")
         self.assertEqual([s["progress"]["fraction"] for s in seen], [0.25, 0.5, 1.0])
         # The second connection asked for the events after id 2, none again.
@@ -129,7 +129,7 @@ class WaitTest(unittest.TestCase):
                                       status("done", 1.0)])
         self.addCleanup(farm.close)
         seen = []
-        final = skyfarm.Client(farm.url).render("r1").wait(progress=seen.append, poll_interval=0.01)
+        final = skyfarm.Client(farm.url).get_render("r1").wait(progress=seen.append, poll_interval=0.01)
         self.assertEqual(final["state"], "done")
         self.assertEqual(farm.status_polls, 4)
         # Unchanged documents are not reported twice.
@@ -140,7 +140,7 @@ class WaitTest(unittest.TestCase):
         farm = ScriptedFarm(streams=[frame(1, "failed", failed)], statuses=[failed])
         self.addCleanup(farm.close)
         with self.assertRaises(skyfarm.RenderFailed) as caught:
-            skyfarm.Client(farm.url).render("r1").wait()
+            skyfarm.Client(farm.url).get_render("r1").wait()
         self.assertEqual(caught.exception.state, "failed")
         self.assertIn("worker crashed", str(caught.exception))
 

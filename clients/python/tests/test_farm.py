@@ -3,6 +3,7 @@ and wait (progress reported and increasing), download, cancel, problems
 naming the field, the sky look-ups, probes, timelapses, assets, workers,
 the bearer token.  Tiny requests: the whole module runs in seconds."""
 
+import datetime
 import hashlib
 import os
 import shutil
@@ -151,6 +152,11 @@ class SkyTest(unittest.TestCase):
         self.assertAlmostEqual(answer["sun"]["zenith_deg"], 25.4, delta=0.3)
         self.assertGreater(answer["luminance_cd_m2"], 0)
         self.assertEqual(answer["luminance_cd_m2"], answer["xyz"]["Y"])
+        # An aware datetime is the same instant.
+        cest = datetime.timezone(datetime.timedelta(hours=2))
+        again = self.client.sky(lat=48.85, lon=2.35, time=datetime.datetime(2021, 6, 21, 13, 50, tzinfo=cest),
+                                view_zenith=30, view_azimuth=180)
+        self.assertEqual(again, answer)
 
     def test_sky_bad_parameter_names_it(self):
         with self.assertRaises(skyfarm.ValidationError) as caught:
@@ -193,13 +199,16 @@ class FarmTest(unittest.TestCase):
         self.assertTrue(self.client.health())
 
     def test_timelapse(self):
-        request = dict(LUT_REQUEST, start="2013-05-27T19:00:00-04:00", end="2013-05-27T19:10:00-04:00",
+        edt = datetime.timezone(datetime.timedelta(hours=-4))  # datetimes go as ISO 8601
+        request = dict(LUT_REQUEST, start=datetime.datetime(2013, 5, 27, 19, 0, tzinfo=edt),
+                       end=datetime.datetime(2013, 5, 27, 19, 10, tzinfo=edt),
                        frames=2, location={"latitude_deg": 42.44, "longitude_deg": -76.48})
         del request["sun"]
         timelapse = self.client.timelapse(request)
         final = timelapse.wait(timeout=60, poll_interval=0.2)
         self.assertEqual(final["state"], "done")
         self.assertEqual(final["progress"]["frames_done"], 2)
+        self.assertEqual([f["time"] for f in final["frames"]], ["2013-05-27T19:00:00-04:00", "2013-05-27T19:10:00-04:00"])
         folder = scratch(self, "skyfarm-pyclient-tl-")
         written = timelapse.download(folder)
         names = sorted(os.path.basename(p) for p in written)
