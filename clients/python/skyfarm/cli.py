@@ -17,7 +17,6 @@ cancelled, 130 interrupted (the render goes on on the server).
 
 import argparse
 import json
-import os
 import sys
 
 from . import __version__
@@ -78,7 +77,11 @@ def cmd_render(client, args):
     if not args.output and not args.png:
         raise SystemExit("skyfarm render: error: give -o FILE.exr and/or --png FILE.png")
     render = client.submit(args.request, idempotency_key=args.idempotency_key)
-    how = " (from the result cache)" if render.from_cache else (" (submitted before)" if render.created is False else "")
+    how = ""
+    if render.from_cache:
+        how = " (from the result cache)"
+    elif render.created is False:
+        how = " (submitted before)"
     _note("render %s%s: %s%s" % (render.id, how, client.url, render.path))
     status = _wait(render, args)
     _download(render, args)

@@ -14,33 +14,13 @@ import socket
 import time
 from http.client import HTTPException
 
-from .errors import RenderFailed, ServerError, TransportError, WaitTimeout
-from .progress import ProgressBar
+from .errors import RenderFailed, ServerError, TransportError
 from .sse import iter_events
+from .waiting import TERMINAL_STATES, Deadline, Reconnects, progress_callback
 
-TERMINAL_STATES = ("done", "failed", "cancelled")
-
-# A connection that broke is tried again after a pause that doubles from
-# 0.25 s to 4 s; the wait gives up (TransportError) after this long without
-# reaching the server.  The farm survives a restart of its server, so a
-# client may well ride one out.
-_RECONNECT_FOR_S = 60.0
 # The server sends ": keepalive" every 10 s (by default) on a quiet stream:
 # a read that waits much longer than that means the connection is dead.
 _STREAM_READ_TIMEOUT_S = 45.0
-
-
-def progress_callback(progress):
-    """The callable for ``wait(progress=...)`` and whether we made it:
-    None: nothing; True: a ``ProgressBar`` on stderr; a callable: itself."""
-    if progress is None or progress is False:
-        return (lambda status: None), None
-    if progress is True:
-        bar = ProgressBar()
-        return bar, bar
-    if not callable(progress):
-        raise TypeError("progress must be None, True or a callable taking the status document")
-    return progress, None
 
 
 def image_format(path, format=None):
@@ -52,43 +32,6 @@ def image_format(path, format=None):
     if format not in ("exr", "png"):
         raise ValueError("format must be 'exr' or 'png', not %r" % format)
     return format
-
-
-class _Deadline:
-    def __init__(self, timeout):
-        self.end = None if timeout is None else time.monotonic() + timeout
-
-    def left(self):
-        return None if self.end is None else self.end - time.monotonic()
-
-    def check(self, what):
-        if self.end is not None and time.monotonic() >= self.end:
-            raise WaitTimeout("%s did not end within the timeout" % what)
-
-    def cap(self, seconds):
-        left = self.left()
-        return seconds if left is None else max(0.01, min(seconds, left))
-
-
-class _Reconnects:
-    """Pauses between tries to reach the server, and when to give up."""
-
-    def __init__(self):
-        self.failing_since = None
-        self.pause = 0.25
-
-    def ok(self):
-        self.failing_since = None
-        self.pause = 0.25
-
-    def failed(self, error, deadline):
-        now = time.monotonic()
-        if self.failing_since is None:
-            self.failing_since = now
-        if now - self.failing_since > _RECONNECT_FOR_S:
-            raise error
-        time.sleep(deadline.cap(self.pause))
-        self.pause = min(self.pause * 2, 4.0)
 
 
 class Render:
@@ -160,7 +103,7 @@ class Render:
         unless ``raise_on_failure`` is false.
         """
         callback, own_bar = progress_callback(progress)
-        deadline = _Deadline(timeout)
+        deadline = Deadline(timeout)
         try:
             status = self._follow_events(callback, deadline)
             if status is None:  # the server refused the stream
@@ -186,7 +129,7 @@ class Render:
         refuses streams (503)."""
         transport = self.client._transport
         last_id = None
-        reconnects = _Reconnects()
+        reconnects = Reconnects()
         while True:
             deadline.check("render " + self.id)
             try:
@@ -229,7 +172,7 @@ class Render:
             reconnects.failed(TransportError("event stream of render %s ended early" % self.id), deadline)
 
     def _poll(self, callback, deadline, poll_interval):
-        reconnects = _Reconnects()
+        reconnects = Reconnects()
         previous = None
         while True:
             try:

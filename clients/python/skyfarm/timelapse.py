@@ -10,7 +10,8 @@ import os
 import time
 
 from .errors import NotFound, RenderFailed, TransportError
-from .render import TERMINAL_STATES, Render, _Deadline, _Reconnects, image_format, progress_callback
+from .render import Render, image_format
+from .waiting import TERMINAL_STATES, Deadline, Reconnects, progress_callback
 
 
 class Timelapse:
@@ -50,8 +51,8 @@ class Timelapse:
         made), failed or cancelled; its final status document.  The
         arguments are those of ``Render.wait``."""
         callback, own_bar = progress_callback(progress)
-        deadline = _Deadline(timeout)
-        reconnects = _Reconnects()
+        deadline = Deadline(timeout)
+        reconnects = Reconnects()
         previous = None
         try:
             while True:

@@ -10,7 +10,9 @@ import tempfile
 import unittest
 
 sys.path.insert(0, os.path.dirname(__file__))
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
+import skyfarm  # noqa: E402
 from farm_server import CLIENT_DIR, EXR_MAGIC, PNG_SIGNATURE, FarmServer, png_size  # noqa: E402
 
 farm = None
@@ -111,9 +113,7 @@ class CliTest(unittest.TestCase):
         request = self.write_request({"sun": {"zenith_deg": 40, "azimuth_deg": 180}, "seed": 202,
                                       "camera": {"projection": "equirectangular", "width": 64, "height": 32},
                                       "quality": {"samples_per_pixel": 100000}})
-        # Submitted with the library's own route, then cancelled by the CLI.
-        sys.path.insert(0, CLIENT_DIR)
-        import skyfarm
+        # Submitted with the library, then cancelled by the command.
         render = skyfarm.Client(farm.url).submit(request)
         code, out, err = skyfarm_cli("cancel", render.id)
         self.assertEqual(code, 0, err)

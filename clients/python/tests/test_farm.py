@@ -208,7 +208,8 @@ class FarmTest(unittest.TestCase):
         final = timelapse.wait(timeout=60, poll_interval=0.2)
         self.assertEqual(final["state"], "done")
         self.assertEqual(final["progress"]["frames_done"], 2)
-        self.assertEqual([f["time"] for f in final["frames"]], ["2013-05-27T19:00:00-04:00", "2013-05-27T19:10:00-04:00"])
+        self.assertEqual([f["time"] for f in final["frames"]],
+                         ["2013-05-27T19:00:00-04:00", "2013-05-27T19:10:00-04:00"])
         folder = scratch(self, "skyfarm-pyclient-tl-")
         written = timelapse.download(folder)
         names = sorted(os.path.basename(p) for p in written)
