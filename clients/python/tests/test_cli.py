@@ -13,7 +13,7 @@ sys.path.insert(0, os.path.dirname(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 import skyfarm  # noqa: E402
-from farm_server import CLIENT_DIR, EXR_MAGIC, PNG_SIGNATURE, FarmServer, png_size  # noqa: E402
+from farm_server import CLIENT_DIR, EXR_MAGIC, PNG_SIGNATURE, SOURCE_DIR, FarmServer, png_size  # noqa: E402
 
 farm = None
 
@@ -156,6 +156,31 @@ class CliTest(unittest.TestCase):
         self.assertIn("contact_sheet.png", files)
         self.assertIn("frame_0001.png", files)
         self.assertNotIn("frame_0000.exr", files)
+
+    def test_probe_prints_json(self):
+        request = self.write_request({"sun": {"zenith_deg": 30, "azimuth_deg": 180}, "method": "lut",
+                                      "directions": [{"zenith_deg": 10, "azimuth_deg": 0}], "wavelengths_nm": [500]})
+        code, out, err = skyfarm_cli("probe", request)
+        self.assertEqual(code, 0, err)
+        answer = json.loads(out)
+        self.assertEqual(answer["wavelengths_nm"], [500])
+        self.assertGreater(answer["radiance"][0][0], 0)
+
+    def test_assets_upload_get_download(self):
+        mesh = os.path.join(SOURCE_DIR, "api", "examples", "assets", "pavilion.obj")
+        code, out, err = skyfarm_cli("assets", "upload", mesh)
+        self.assertEqual(code, 0, err)
+        asset = json.loads(out)
+        code, out, err = skyfarm_cli("assets", "get", asset["id"])
+        self.assertEqual(code, 0, err)
+        self.assertEqual(json.loads(out)["id"], asset["id"])
+        path = os.path.join(self.folder, "mesh.bin")
+        code, _, err = skyfarm_cli("assets", "download", asset["id"], "-o", path)
+        self.assertEqual(code, 0, err)
+        self.assertEqual(os.path.getsize(path), asset["bytes"])
+        code, _, err = skyfarm_cli("assets", "get", "sha256:nothex")
+        self.assertEqual(code, 1)
+        self.assertIn("skyfarm: error: id: ", err)
 
     def test_workers_and_no_server(self):
         code, out, err = skyfarm_cli("workers")
