@@ -71,6 +71,11 @@ class Transport:
         self.url = url.rstrip("/")
         self.token = token
         self.timeout = timeout
+        # The environment's http_proxy applies, except to this machine: no
+        # proxy can reach our loopback, and CI machines often set one.
+        host = urllib.parse.urlsplit(self.url).hostname or ""
+        loopback = host in ("localhost", "::1") or host.startswith("127.")
+        self._opener = urllib.request.build_opener(*([urllib.request.ProxyHandler({})] if loopback else []))
 
     def _request(self, method, path, query=None, body=None, headers=None):
         all_headers = {"User-Agent": "skyfarm-python/" + __version__, "Accept": "*/*"}
@@ -85,7 +90,7 @@ class Transport:
         the caller closes it."""
         request = self._request(method, path, query, body, headers)
         try:
-            return urllib.request.urlopen(request, timeout=timeout or self.timeout)
+            return self._opener.open(request, timeout=timeout or self.timeout)
         except urllib.error.HTTPError as e:
             try:
                 data = e.read()
