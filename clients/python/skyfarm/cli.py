@@ -5,6 +5,7 @@
   --server URL   the farm (default $SKYFARM_URL, else http://127.0.0.1:8080)
   --token TOKEN  bearer token of a server run with --token (default $SKYFARM_TOKEN)
   --timeout S    seconds one HTTP exchange may take (default 60)
+  --busy-wait S  retry for S seconds while the farm is at capacity (429)
 
 Commands: render (= submit, wait, download), submit, wait, download, status,
 cancel, renders, sky, envmap, probe, timelapse, timelapses, workers, assets
@@ -211,7 +212,7 @@ def cmd_assets(client, args):
 # --- the parser ----------------------------------------------------------------
 
 def _connection_options(parser, suppress):
-    """--server, --token, --timeout: before the command, or after it
+    """--server, --token, --timeout, --busy-wait: before the command, or after it
     (``suppress``: a subcommand's copy must not reset the main one's value)."""
     default = (lambda value: argparse.SUPPRESS) if suppress else (lambda value: value)
     parser.add_argument("--server", metavar="URL", default=default(None),
@@ -220,6 +221,9 @@ def _connection_options(parser, suppress):
                         help="bearer token of a server run with --token (default $SKYFARM_TOKEN)")
     parser.add_argument("--timeout", type=float, metavar="S", default=default(60.0),
                         help="seconds one HTTP exchange may take (default 60)")
+    parser.add_argument("--busy-wait", type=float, metavar="S", default=default(0.0),
+                        help="keep retrying for S seconds while the farm answers 429 (at capacity) or 503 "
+                             "with Retry-After (default 0: fail at once)")
 
 
 def build_parser():
@@ -326,7 +330,7 @@ def build_parser():
 def main(argv=None):
     args = build_parser().parse_args(argv)
     try:
-        client = Client(args.server, args.token, timeout=args.timeout)
+        client = Client(args.server, args.token, timeout=args.timeout, busy_wait_s=args.busy_wait)
         return args.handler(client, args)
     except RenderFailed as e:
         _note("skyfarm: %s" % e)

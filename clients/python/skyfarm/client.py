@@ -1,6 +1,6 @@
 """The farm's API as Python calls.
 
-Parameters (``Client(url=None, token=None, timeout=60)``):
+Parameters (``Client(url=None, token=None, timeout=60, busy_wait_s=0)``):
   url      the server, ``http://127.0.0.1:8080`` by default, else the
            environment's ``SKYFARM_URL``; a path prefix (a proxy's) is kept
   token    the bearer token of a server run with ``--token``; default the
@@ -8,6 +8,10 @@ Parameters (``Client(url=None, token=None, timeout=60)``):
   timeout  seconds one HTTP exchange may wait for the server (a path-traced
            probe gets at least 180: the server waits up to its
            ``--probe-timeout``, 120 s by default)
+  busy_wait_s  how long to keep retrying a request the server refuses for
+           now with Retry-After (429 farm at capacity, 503 no probe
+           workers), as it says; 0 (default): raise ``TooManyRequests`` /
+           ``ServerError`` at once
 
 Every route of api/openapi.yaml has a method; requests and query
 parameters pass through as given (a dict, or a JSON file's path), so new
@@ -85,10 +89,10 @@ class Assets:
 
 
 class Client:
-    def __init__(self, url=None, token=None, timeout=60.0):
+    def __init__(self, url=None, token=None, timeout=60.0, busy_wait_s=0.0):
         url = url or os.environ.get("SKYFARM_URL") or DEFAULT_URL
         token = token if token is not None else (os.environ.get("SKYFARM_TOKEN") or None)
-        self._transport = Transport(url, token, timeout)
+        self._transport = Transport(url, token, timeout, busy_wait_s)
         self.assets = Assets(self._transport)
 
     @property

@@ -86,7 +86,7 @@ class Render:
         ``wait`` does that."""
         answer = self.client._transport.open("GET", self.path + "/events",
                                              headers=self._event_headers(last_event_id),
-                                             timeout=_STREAM_READ_TIMEOUT_S)
+                                             timeout=_STREAM_READ_TIMEOUT_S, busy_wait=False)
         with answer:
             for event in iter_events(answer, last_event_id):
                 yield event.event, json.loads(event.data)
@@ -134,7 +134,7 @@ class Render:
             deadline.check("render " + self.id)
             try:
                 answer = transport.open("GET", self.path + "/events", headers=self._event_headers(last_id),
-                                        timeout=deadline.cap(_STREAM_READ_TIMEOUT_S))
+                                        timeout=deadline.cap(_STREAM_READ_TIMEOUT_S), busy_wait=False)
             except ServerError as e:
                 if e.status == 503:
                     return None

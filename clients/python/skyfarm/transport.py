@@ -14,13 +14,14 @@ import json
 import os
 import socket
 import tempfile
+import time
 import urllib.error
 import urllib.parse
 import urllib.request
 from http.client import HTTPException
 
 from . import __version__
-from .errors import TransportError, problem_error
+from .errors import ProblemError, TransportError, problem_error
 
 _CHUNK = 1 << 16
 
@@ -65,12 +66,19 @@ class Response:
 
 
 class Transport:
-    def __init__(self, url, token=None, timeout=60.0):
+    """``busy_wait_s``: how long to keep trying a request the server refuses
+    for now with a ``Retry-After`` (429: the farm is at capacity; 503: no
+    workers for a probe, or every connection taken), waiting as it says
+    between tries; 0: raise at once.  Such a refusal changed nothing on the
+    server, so trying again is safe for every method."""
+
+    def __init__(self, url, token=None, timeout=60.0, busy_wait_s=0.0):
         if "://" not in url:
             url = "http://" + url
         self.url = url.rstrip("/")
         self.token = token
         self.timeout = timeout
+        self.busy_wait_s = busy_wait_s
         # The environment's http_proxy applies, except to this machine: no
         # proxy can reach our loopback, and CI machines often set one.
         host = urllib.parse.urlsplit(self.url).hostname or ""
@@ -85,9 +93,23 @@ class Transport:
         return urllib.request.Request(self.url + path + query_string(query), data=body, method=method,
                                       headers=all_headers)
 
-    def open(self, method, path, query=None, body=None, headers=None, timeout=None):
+    def open(self, method, path, query=None, body=None, headers=None, timeout=None, busy_wait=True):
         """The open answer of a 2xx (a file-like http.client.HTTPResponse);
-        the caller closes it."""
+        the caller closes it.  ``busy_wait``: False to raise a 429 or 503 at
+        once whatever ``busy_wait_s`` says (the event stream polls instead)."""
+        start = time.monotonic()
+        while True:
+            try:
+                return self._open_once(method, path, query, body, headers, timeout)
+            except ProblemError as e:
+                if not busy_wait or e.status not in (429, 503) or e.retry_after is None:
+                    raise
+                pause = max(e.retry_after, 0.05)
+                if time.monotonic() + pause - start > self.busy_wait_s:
+                    raise
+                time.sleep(pause)
+
+    def _open_once(self, method, path, query, body, headers, timeout):
         request = self._request(method, path, query, body, headers)
         try:
             return self._opener.open(request, timeout=timeout or self.timeout)

@@ -27,12 +27,12 @@ def binary(variable, default):
 
 
 class FarmServer:
-    """``FarmServer(local_workers=2, token=None)``: started at once;
-    ``url``, ``log()``, ``stop()``."""
+    """``FarmServer(local_workers=2, token=None, extra=())``: started at
+    once (``extra``: more flags); ``url``, ``log()``, ``stop()``."""
 
     _READY = re.compile(r"HTTP on http://127\.0\.0\.1:(\d+), broker on (\S+),")
 
-    def __init__(self, local_workers=2, token=None, start_timeout_s=20.0):
+    def __init__(self, local_workers=2, token=None, extra=(), start_timeout_s=20.0):
         self.folder = tempfile.mkdtemp(prefix="skyfarm-pyclient-")
         args = [binary("SKYFARM_TEST_SERVER_BINARY", "build/server/skyfarm-server"),
                 "--listen", "127.0.0.1:0", "--broker", "tcp://127.0.0.1:*",
@@ -40,6 +40,7 @@ class FarmServer:
                 "--worker-binary", binary("SKYFARM_TEST_WORKER_BINARY", "build/worker/skyfarm-worker")]
         if token:
             args += ["--token", token]
+        args += list(extra)
         env = {k: v for k, v in os.environ.items() if not k.startswith("SKYFARM_")}
         self._lines = []
         self._ready = threading.Event()

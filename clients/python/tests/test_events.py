@@ -30,9 +30,13 @@ class ScriptedFarm:
     """Answers /v1/renders/r1 and /v1/renders/r1/events from a script:
     ``streams`` is a list, one entry per connection to the events, each the
     bytes to send before closing (or the int 503 to refuse); ``statuses``
-    the documents successive status polls answer (the last repeats)."""
+    the documents successive status polls answer (the last repeats); POST
+    /v1/renders is refused ``refusals`` times (429, Retry-After 0), then
+    accepted."""
 
-    def __init__(self, streams, statuses):
+    def __init__(self, streams=(), statuses=(), refusals=0):
+        self.refusals = refusals  # POST /v1/renders answers 429 this many times first
+        self.posts = 0
         self.streams = list(streams)
         self.statuses = list(statuses)
         self.last_event_ids = []  # the Last-Event-ID header of each stream request
@@ -42,6 +46,25 @@ class ScriptedFarm:
         class Handler(BaseHTTPRequestHandler):
             def log_message(self, *args):
                 pass
+
+            def do_POST(self):
+                self.rfile.read(int(self.headers.get("Content-Length", 0)))
+                farm.posts += 1
+                if farm.refusals:
+                    farm.refusals -= 1
+                    body = json.dumps({"type": "urn:skyfarm:problem:capacity-exceeded", "status": 429,
+                                       "title": "The farm is at capacity", "detail": "64 active jobs"}).encode()
+                    self.send_response(429)
+                    self.send_header("Content-Type", "application/problem+json")
+                    self.send_header("Retry-After", "0")
+                else:
+                    body = json.dumps({"id": "r1", "state": "queued", "created": True, "from_cache": False,
+                                       "links": {"self": "/v1/renders/r1"}}).encode()
+                    self.send_response(202)
+                    self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body)
 
             def do_GET(self):
                 if self.path == "/v1/renders/r1/events":
@@ -143,6 +166,23 @@ class WaitTest(unittest.TestCase):
             skyfarm.Client(farm.url).get_render("r1").wait()
         self.assertEqual(caught.exception.state, "failed")
         self.assertIn("worker crashed", str(caught.exception))
+
+
+class BusyTest(unittest.TestCase):
+    def test_busy_wait_retries_a_refused_submission(self):
+        farm = ScriptedFarm(refusals=2)
+        self.addCleanup(farm.close)
+        render = skyfarm.Client(farm.url, busy_wait_s=5).submit({"camera": {"projection": "fisheye"}})
+        self.assertEqual(render.id, "r1")
+        self.assertEqual(farm.posts, 3)
+
+    def test_no_busy_wait_raises_at_once(self):
+        farm = ScriptedFarm(refusals=1)
+        self.addCleanup(farm.close)
+        with self.assertRaises(skyfarm.TooManyRequests) as caught:
+            skyfarm.Client(farm.url).submit({"camera": {"projection": "fisheye"}})
+        self.assertEqual(caught.exception.retry_after, 0)
+        self.assertEqual(farm.posts, 1)
 
 
 class ProblemTest(unittest.TestCase):

@@ -238,6 +238,25 @@ class FarmTest(unittest.TestCase):
         self.assertEqual("sha256:" + hashlib.sha256(data).hexdigest(), asset["id"])  # the id is its hash
 
 
+class CapacityTest(unittest.TestCase):
+    def test_full_farm_answers_429_with_retry_after(self):
+        # One active job allowed and no workers: the first render stays
+        # queued, the second is refused for now.
+        full = FarmServer(local_workers=0, extra=["--max-active-jobs", "1"])
+        self.addCleanup(full.stop)
+        client = skyfarm.Client(full.url)
+        client.submit(LUT_REQUEST)
+        with self.assertRaises(skyfarm.TooManyRequests) as caught:
+            client.submit(path_request(seed=105))
+        self.assertEqual(caught.exception.status, 429)
+        self.assertEqual(caught.exception.retry_after, 10)  # server/http/http_problem.cpp
+        # Waiting less than the Retry-After does not try again.
+        started = time.monotonic()
+        with self.assertRaises(skyfarm.TooManyRequests):
+            skyfarm.Client(full.url, busy_wait_s=5).submit(path_request(seed=105))
+        self.assertLess(time.monotonic() - started, 5)
+
+
 class TokenTest(unittest.TestCase):
     def test_bearer_token(self):
         guarded = FarmServer(local_workers=0, token="s3cret-token")
