@@ -112,7 +112,7 @@ class Render:
             if own_bar is not None:
                 own_bar.close()
         if raise_on_failure and status.get("state") in ("failed", "cancelled"):
-            reason = status.get("failure") or status.get("stopped_by") or ""
+            reason = status.get("failure") or ""
             raise RenderFailed("render %s %s%s" % (self.id, status.get("state"), ": " + reason if reason else ""),
                                status.get("state"), status)
         return status
