@@ -23,6 +23,7 @@
 #include "server/sky/http_sky.h"
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
+#include "server/timelapse/timelapse_service.h"
 #include "server/assets/asset_admission.h"
 #include "server/assets/asset_http.h"
 #include "api/probe_answer.h"
@@ -548,7 +549,10 @@ void HttpApi::metrics(const Request&, Response& res) {
       else if (it->is_number_unsigned() && value.is_number_unsigned()) *it = it->get<std::uint64_t>() + value.get<std::uint64_t>();
       else *it = it->get<double>() + value.get<double>();
     }
-  std::string text = prometheus_text(figures, responses_, open_streams(), &requests_, backend_.histograms());
+  std::vector<HistogramSeries> histograms = backend_.histograms();
+  if (options_.timelapses)  // kind="timelapse" series of skyfarm_job_duration_seconds
+    for (HistogramSeries& h : options_.timelapses->histograms()) histograms.push_back(std::move(h));
+  std::string text = prometheus_text(figures, responses_, open_streams(), &requests_, histograms);
   append_sky_cache_metrics(text, sky_->service().stats());
   if (options_.probes) append_probe_metrics(text, options_.probes->stats());
   if (gate_) append_gate_metrics(text, gate_->stats());

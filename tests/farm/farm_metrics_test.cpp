@@ -191,7 +191,9 @@ TEST(FarmMetrics, ScrapeAfterRendersHasHistogramsCountersAndBuildInfo) {
   EXPECT_EQ(after.at("skyfarm_job_duration_seconds_count{kind=\"render\",state=\"done\"}"), 2.0);
   EXPECT_EQ(after.at("skyfarm_job_duration_seconds_count{kind=\"render\",state=\"failed\"}"), 0.0);
   EXPECT_EQ(check_histogram(after, "skyfarm_unit_duration_seconds"), 2);
-  EXPECT_EQ(check_histogram(after, "skyfarm_job_duration_seconds"), 3);
+  // kind="render" and kind="timelapse", each by done, failed, cancelled.
+  EXPECT_EQ(check_histogram(after, "skyfarm_job_duration_seconds"), 6);
+  EXPECT_EQ(after.at("skyfarm_job_duration_seconds_count{kind=\"timelapse\",state=\"done\"}"), 0.0);
   EXPECT_GE(check_histogram(after, "skyfarm_http_request_duration_seconds"), 2);
   // Counters never go down between scrapes.
   for (const auto& [series, value] : before.samples) {
