@@ -96,7 +96,7 @@ std::vector<HistogramSeries> JobBook::histograms() const {
   constexpr const char* kUnit = "skyfarm_unit_duration_seconds";
   constexpr const char* kUnitHelp = "Work units from dispatch to result merged, by render method.";
   constexpr const char* kJob = "skyfarm_job_duration_seconds";
-  constexpr const char* kJobHelp = "Renders from submission to their end, by final state.";
+  constexpr const char* kJobHelp = "Renders and timelapses from submission to their end, by kind and final state.";
   return {{kUnit, kUnitHelp, "method=\"path\"", unit_seconds_path.snapshot()},
           {kUnit, kUnitHelp, "method=\"lut\"", unit_seconds_lut.snapshot()},
           {kJob, kJobHelp, "kind=\"render\",state=\"done\"", job_seconds_done.snapshot()},

@@ -209,7 +209,7 @@ void TimelapseService::observe_end(const Entry& t) {
 
 std::vector<HistogramSeries> TimelapseService::histograms() const {
   constexpr const char* kName = "skyfarm_job_duration_seconds";
-  constexpr const char* kHelp = "Renders from submission to their end, by final state.";
+  constexpr const char* kHelp = "Renders and timelapses from submission to their end, by kind and final state.";
   return {{kName, kHelp, "kind=\"timelapse\",state=\"done\"", durations_done_.snapshot()},
           {kName, kHelp, "kind=\"timelapse\",state=\"failed\"", durations_failed_.snapshot()},
           {kName, kHelp, "kind=\"timelapse\",state=\"cancelled\"", durations_cancelled_.snapshot()}};
