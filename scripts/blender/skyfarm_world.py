@@ -47,6 +47,7 @@ import math
 import os
 import sys
 import tempfile
+import urllib.error
 import urllib.parse
 import urllib.request
 
