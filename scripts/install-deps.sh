@@ -3,6 +3,8 @@
 # Safe to run again: it only calls apt-get when something is not installed.
 #   --browser   also headless Chromium and its WebDriver (chromium,
 #               chromium-driver) for the web page's test (scripts/test.sh)
+#   --dcc       also Blender, for the test that loads a sky as Blender's World
+#               and renders with Cycles (tests/dcc, scripts/blender)
 set -euo pipefail
 
 packages=(
@@ -24,7 +26,8 @@ packages=(
 for arg in "$@"; do
   case $arg in
     --browser) packages+=(chromium chromium-driver) ;;
-    *) echo "install-deps.sh: unknown option $arg (known: --browser)" >&2; exit 2 ;;
+    --dcc) packages+=(blender) ;;
+    *) echo "install-deps.sh: unknown option $arg (known: --browser, --dcc)" >&2; exit 2 ;;
   esac
 done
 

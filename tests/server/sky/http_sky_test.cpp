@@ -218,6 +218,9 @@ TEST_F(SkyHttpTest, BadParametersAre400NamingTheParameter) {
   expect_bad("/v1/sky/envmap.exr?" + sun + "&sun=bright", "sun");
   expect_bad("/v1/sky/envmap.exr?" + sun + "&altitude=200000&width=2048", "width");  // a ray march per pixel
   expect_bad("/v1/sky/envmap.exr?" + sun + "&view_zenith=0", "view_zenith");  // lookup only
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=cube", "layout");
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=equal_area&width=8192", "width");  // 4096 at most
+  expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&layout=equal_area", "layout");  // envmap only
   // Every error at once, each by its name.
   auto r = client().Get("/v1/sky?lat=95&view_azimuth=400&foo=1");
   ASSERT_TRUE(r);
@@ -332,6 +335,52 @@ TEST_F(SkyHttpTest, EnvmapPixelsAgreeWithLookupsAlongTheirDirections) {
         << x << "," << y;
   }
   EXPECT_EQ(service_->stats().table_builds, 1u) << "the map and the look-ups share the table";
+}
+
+TEST_F(SkyHttpTest, EqualAreaEnvmapIsSquareWithTheZenithAtTheCentre) {
+  start();
+  auto c = client();
+  // The default layout's canonical request has no `layout` key (older maps keep their bytes).
+  auto latlong = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none");
+  ASSERT_TRUE(latlong);
+  ASSERT_EQ(latlong->status, 200);
+  const auto latlong_request =
+      nlohmann::json::parse(read_exr_bytes(latlong->body).string_attributes.at("skyfarm:request"));
+  EXPECT_FALSE(latlong_request.contains("layout"));
+  auto same = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none&layout=latlong");
+  ASSERT_TRUE(same);
+  EXPECT_TRUE(same->body == latlong->body) << "layout=latlong is the default, byte for byte";
+
+  auto r = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&layout=equal_area");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const ExrFile exr = read_exr_bytes(r->body);
+  EXPECT_EQ(exr.width, 64);
+  EXPECT_EQ(exr.height, 64);
+  EXPECT_EQ(exr.string_attributes.at("skyfarm:layout").rfind("equal_area", 0), 0u);
+  EXPECT_EQ(nlohmann::json::parse(exr.string_attributes.at("skyfarm:request"))["layout"], "equal_area");
+  EXPECT_EQ(r->body.find("envmap"), std::string::npos) << "no LATLONG envmap attribute";
+  // The brightest pixel is the sun's: east of the zenith (right of the
+  // centre), on the centre row; zenith 60 deg -> r = sqrt(1 - cos 60) = 0.707
+  // of the half width: x = 32 + 0.707 x 32 = 54.6.
+  const auto& R = exr.channels.at("R").values;
+  const auto& G = exr.channels.at("G").values;
+  const auto& B = exr.channels.at("B").values;
+  std::size_t best = 0;
+  double best_y = -1;
+  for (std::size_t i = 0; i < R.size(); ++i) {
+    const double y = 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+    if (y > best_y) best_y = y, best = i;
+  }
+  EXPECT_NEAR(static_cast<int>(best % 64), 54, 1);
+  EXPECT_NEAR(static_cast<int>(best / 64), 32, 1);
+  // The corners are the nadir: the ground, darker than the zenith at the centre.
+  auto Y = [&](int x, int y) {
+    const std::size_t i = static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x);
+    return 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+  };
+  EXPECT_GT(Y(31, 31), Y(0, 0));
+  EXPECT_GT(Y(0, 0), 0.0);
 }
 
 TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
