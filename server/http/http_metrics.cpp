@@ -153,7 +153,7 @@ void append_histogram(std::string& out, std::string_view name, std::string_view 
 void append_build_info(std::string& out) {
   const BuildInfo& b = build_info();
   append_metric_header(out, "skyfarm_build_info", "gauge",
-                       "Always 1; the labels say which build serves (version, commit, compiler, build type).");
+                       "Always 1; which build serves: its version, commit, compiler and build type.");
   append_metric_sample(out, "skyfarm_build_info",
                        "version=\"" + escaped_label_value(b.version) + "\",git_commit=\"" +
                            escaped_label_value(b.git_commit) + "\",compiler=\"" + escaped_label_value(b.compiler) +
