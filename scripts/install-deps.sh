@@ -19,6 +19,7 @@ packages=(
   ffmpeg
   file                        # cpack -G DEB finds the programs' libraries with it
   yamllint python3-yaml       # the deployment files' tests (tests/deploy)
+  python3                     # the Python client (clients/python): scripts/run.sh, its test Client.Python
   libjson-validator-perl      # the OpenAPI document's lint (tests/api/openapi_lint.pl)
   tcpdump iproute2            # the multi-host test (tests/farm/multi_host_netns.sh)
 )

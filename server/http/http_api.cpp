@@ -3,6 +3,8 @@
 #include <httplib.h>
 
 #include <algorithm>
+#include <chrono>
+#include <optional>
 #include <ctime>
 #include <limits>
 #include <thread>
@@ -21,6 +23,7 @@
 #include "server/sky/http_sky.h"
 #include "server/http/http_web.h"
 #include "server/timelapse/timelapse_http.h"
+#include "server/timelapse/timelapse_service.h"
 #include "server/assets/asset_admission.h"
 #include "server/assets/asset_http.h"
 #include "api/probe_answer.h"
@@ -63,6 +66,11 @@ constexpr std::size_t kKeepAliveMaxCount = 100;
 constexpr std::time_t kKeepAliveTimeoutS = 3;
 constexpr int kMinSpareThreads = 4;        // beyond the stream slots, whatever http_threads says
 constexpr int kStreamRetryAfterS = 5;      // 503 when every stream slot is taken
+
+// When the request on this thread was routed (the pre-routing handler),
+// for skyfarm_http_request_duration_seconds; the logger reads and clears it.
+// httplib serves a request on one thread from routing to logging.
+thread_local std::optional<std::chrono::steady_clock::time_point> request_start;
 
 // Catch-all for methods with a body: the fallback must not read it.
 const char* const kAnyPath = R"([\s\S]*)";
@@ -233,6 +241,7 @@ void HttpApi::configure_server(httplib::Server& server) {
 
   using WithResponse = httplib::Server::HandlerWithResponse;
   server.set_pre_routing_handler(WithResponse([this](const Request& req, Response& res) {
+    request_start = std::chrono::steady_clock::now();
     return admitted(req, res) ? HandlerResponse::Unhandled : HandlerResponse::Handled;
   }));
   server.set_expect_100_continue_handler(
@@ -289,6 +298,13 @@ bool HttpApi::answer_library_error(const Request& req, Response& res) {
 
 void HttpApi::log_response(const Request& req, const Response& res) noexcept {
   responses_.count(res.status);
+  std::optional<double> seconds;
+  if (request_start) seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - *request_start).count();
+  request_start.reset();
+  try {
+    requests_.observe(req.method, req.path, res.status, seconds);
+  } catch (...) {  // out of memory: the count is lost, the connection goes on
+  }
   if (!options_.on_response) return;
   try {
     options_.on_response(req, res);
@@ -349,6 +365,7 @@ void HttpApi::add_routes(httplib::Server& server) {
                                  [this](const Request& req, Response& res, const ContentReader& reader,
                                         std::size_t limit) { return read_body(req, res, reader, limit); }});
   routes_ = routes.added();
+  requests_.set_routes(routes_);
 }
 
 void HttpApi::add_fallbacks(httplib::Server& server) {
@@ -532,7 +549,10 @@ void HttpApi::metrics(const Request&, Response& res) {
       else if (it->is_number_unsigned() && value.is_number_unsigned()) *it = it->get<std::uint64_t>() + value.get<std::uint64_t>();
       else *it = it->get<double>() + value.get<double>();
     }
-  std::string text = prometheus_text(figures, responses_, open_streams());
+  std::vector<HistogramSeries> histograms = backend_.histograms();
+  if (options_.timelapses)  // kind="timelapse" series of skyfarm_job_duration_seconds
+    for (HistogramSeries& h : options_.timelapses->histograms()) histograms.push_back(std::move(h));
+  std::string text = prometheus_text(figures, responses_, open_streams(), &requests_, histograms);
   append_sky_cache_metrics(text, sky_->service().stats());
   if (options_.probes) append_probe_metrics(text, options_.probes->stats());
   if (gate_) append_gate_metrics(text, gate_->stats());

@@ -63,6 +63,7 @@
 
 #include "server/http/http_events.h"
 #include "server/http/http_metrics.h"
+#include "server/http/http_request_metrics.h"
 #include "server/http/http_backend.h"
 #include "server/probes/probe_service.h"
 #include "server/sky/sky_service.h"
@@ -173,6 +174,7 @@ class HttpApi {
   const HttpOptions options_;
   StreamSlots streams_;
   ResponseCounter responses_;
+  HttpRequestMetrics requests_;  // by route template, method, code; durations
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
   std::unique_ptr<AssetHttp> assets_;

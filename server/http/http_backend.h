@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "api/render_request.h"
+#include "common/core/metrics_histogram.h"
 #include "server/jobs/job_errors.h"
 
 namespace skyfarm::server {
@@ -41,6 +42,15 @@ struct JobEvent {
 struct PurgeOutcome {
   enum Kind { kPurged, kUnknown, kConflict } kind = kUnknown;
   std::string detail;  // kConflict: why not (a timelapse's frame, an image being written)
+};
+
+// One series of a /metrics histogram: its family's name and help, its labels
+// as exposed without braces (`method="path"`, "" for none), its counts.
+struct HistogramSeries {
+  std::string name;
+  std::string help;
+  std::string labels;
+  MetricsHistogram::Snapshot snapshot;
 };
 
 class HttpBackend {
@@ -74,6 +84,9 @@ class HttpBackend {
   // "jobs_failed", "workers", "samples_per_second", "unit_failures", "requeues", "results_refused", "disk_used_bytes",
   // "disk_budget_bytes" (0: no limit)} (numbers).
   virtual nlohmann::json metrics() const = 0;
+  // /metrics histograms (skyfarm_unit_duration_seconds, ...), one entry per
+  // series; entries of one name are one family.  None by default.
+  virtual std::vector<HistogramSeries> histograms() const { return {}; }
 };
 
 }  // namespace skyfarm::server

@@ -194,6 +194,11 @@ nlohmann::json JobService::metrics() const {
   return parts_->book.metrics();
 }
 
+std::vector<HistogramSeries> JobService::histograms() const {
+  const std::lock_guard<std::mutex> lock(parts_->book.mu);
+  return parts_->book.histograms();
+}
+
 // --- Broker side ----------------------------------------------------------
 
 void JobService::worker_joined(const std::string& worker_id, const nlohmann::json& info) {

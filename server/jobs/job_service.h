@@ -70,6 +70,7 @@ class JobService final : public HttpBackend, public BrokerBackend {
                                      std::chrono::milliseconds timeout) override;
   nlohmann::json workers() const override;
   nlohmann::json metrics() const override;
+  std::vector<HistogramSeries> histograms() const override;
 
   void worker_joined(const std::string& worker_id, const nlohmann::json& info) override;
   void worker_left(const std::string& worker_id) override;

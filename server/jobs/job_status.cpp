@@ -87,7 +87,21 @@ nlohmann::json JobBook::metrics() const {
           {"requeues", requeues},
           {"results_refused", results_refused},
           {"disk_used_bytes", disk_used()},
-          {"disk_budget_bytes", disk_budget}};
+          {"disk_budget_bytes", disk_budget},
+          {"samples_total", samples_total},
+          {"units_completed", units_completed}};
+}
+
+std::vector<HistogramSeries> JobBook::histograms() const {
+  constexpr const char* kUnit = "skyfarm_unit_duration_seconds";
+  constexpr const char* kUnitHelp = "Work units from dispatch to result merged, by render method.";
+  constexpr const char* kJob = "skyfarm_job_duration_seconds";
+  constexpr const char* kJobHelp = "Renders and timelapses from submission to their end, by kind and final state.";
+  return {{kUnit, kUnitHelp, "method=\"path\"", unit_seconds_path.snapshot()},
+          {kUnit, kUnitHelp, "method=\"lut\"", unit_seconds_lut.snapshot()},
+          {kJob, kJobHelp, "kind=\"render\",state=\"done\"", job_seconds_done.snapshot()},
+          {kJob, kJobHelp, "kind=\"render\",state=\"failed\"", job_seconds_failed.snapshot()},
+          {kJob, kJobHelp, "kind=\"render\",state=\"cancelled\"", job_seconds_cancelled.snapshot()}};
 }
 
 }  // namespace skyfarm::server

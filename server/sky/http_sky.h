@@ -51,12 +51,14 @@
 // lat-long layout of the equirectangular renders (centre = north, right =
 // east, top = zenith; `envmap` attribute LATLONG), linear Rec.709 in cd/m^2
 // (whiteLuminance 1), with skyfarm:* attributes: method "lut", approximate
-// "true", sun_zenith_deg, sun_azimuth_deg, sun_earth_distance_au,
-// sun_angular_radius_deg, sun_mode, wavelength_min_nm, wavelength_max_nm,
+// "true", sun_zenith_deg, sun_azimuth_deg, earth_sun_distance_au (and
+// sun_earth_distance_au, its deprecated alias), sun_angular_radius_deg,
+// sun_mode, wavelength_min_nm, wavelength_max_nm, observer_altitude_m,
 // request (the canonical parameters as JSON), software_version, layout (the
-// mapping and its axes, in words).  With layout=equal_area the image is
-// width x width, has no `envmap` attribute (OpenEXR names only latlong and
-// cube maps) and skyfarm:layout begins "equal_area".  sun =
+// mapping and its axes, in words; docs/exr-metadata.md).  With
+// layout=equal_area the image is width x width, has no `envmap` attribute
+// (OpenEXR names only latlong and cube maps) and skyfarm:layout begins
+// "equal_area".  sun =
 //   disk       the disk in the pixels, integrated over each pixel (its energy
 //              is exact at any width; sky_service.h)
 //   none       no disk

@@ -199,11 +199,28 @@ void TimelapseService::feed(Entry& t, int* active, int* done) {
   }
 }
 
+void TimelapseService::observe_end(const Entry& t) {
+  // Submission to end, wall clock, as the renders' (job_book.cpp).
+  const double seconds = std::max(0.0, t.record.finished_unix - t.record.created_unix);
+  if (t.record.state == JobState::kDone) durations_done_.observe(seconds);
+  else if (t.record.state == JobState::kFailed) durations_failed_.observe(seconds);
+  else if (t.record.state == JobState::kCancelled) durations_cancelled_.observe(seconds);
+}
+
+std::vector<HistogramSeries> TimelapseService::histograms() const {
+  constexpr const char* kName = "skyfarm_job_duration_seconds";
+  constexpr const char* kHelp = "Renders and timelapses from submission to their end, by kind and final state.";
+  return {{kName, kHelp, "kind=\"timelapse\",state=\"done\"", durations_done_.snapshot()},
+          {kName, kHelp, "kind=\"timelapse\",state=\"failed\"", durations_failed_.snapshot()},
+          {kName, kHelp, "kind=\"timelapse\",state=\"cancelled\"", durations_cancelled_.snapshot()}};
+}
+
 void TimelapseService::fail(Entry& t, const std::string& message) {
   cancel_frames(t);
   t.record.state = JobState::kFailed;
   t.record.failure = message;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
 }
 
@@ -265,6 +282,7 @@ void TimelapseService::build_outputs(const std::string& id) {
   t.record.video_reason = report.video_reason;
   t.record.state = JobState::kDone;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
 }
 
@@ -326,6 +344,7 @@ bool TimelapseService::cancel(const std::string& id) {
   cancel_frames(t);
   t.record.state = JobState::kCancelled;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
   return true;
 }
