@@ -15,6 +15,10 @@ Parameters (after Blender's `--`):
   --altitude M      observer altitude above the ground, m
   --aod X           aerosol optical depth at 550 nm
   --width N         the map's width in pixels (height N/2); default 1024
+  --sun disk|lamp   disk (default): the sun disk in the map's pixels; lamp:
+                    the map without it (sun=separate) and a Sun lamp from
+                    the map's skyfarm:sun_* attributes instead (sharper
+                    shadows, far less noise in Cycles)
   --exr PATH        where the map is kept (default: next to --save, else a
                     temporary folder); the image is packed into --save's file
   --strength S      the Background strength; default 1/683 (below)
@@ -37,14 +41,20 @@ What it sets:
   at the luminous efficacy of 555 nm, 683 lm/W, 1/683 turns the map into
   W m^-2 sr^-1 on the same scale, so a Sun lamp of E_v/683 W/m^2 next to this
   world is as bright as a sun giving E_v lux.
+  Sun lamp (--sun lamp): strength = the disk's normal illuminance / 683
+  (W/m^2), colour = the disk's mean Rec.709 radiance over its largest
+  component (the strength carries that component), angle = the disk's
+  angular diameter, pointing away from skyfarm:sun_direction (x east, y
+  north, z up: Blender's axes after the rotation above).
   Exposure: scene values are then about 100-150 W/m^2 irradiance in
   daylight; exposure = log2(683 pi / E_h), with E_h the map's horizontal
-  illuminance (lux, sun included), brings a flat 18 % grey card to 0.18
+  illuminance (lux, sun included, the lamp's too), brings a flat 18 % grey card to 0.18
   (mid-grey in the Filmic and Standard view transforms).
 """
 import argparse
 import math
 import os
+import struct
 import sys
 import tempfile
 import urllib.error
@@ -52,6 +62,7 @@ import urllib.parse
 import urllib.request
 
 import bpy
+import mathutils
 
 LUMINOUS_EFFICACY_LM_PER_W = 683.0  # 555 nm (540 THz): the SI definition of the candela
 # Rec.709 / sRGB luminance weights (ITU-R BT.709): the map's Y from its R, G, B.
@@ -72,6 +83,7 @@ def parse_args(argv):
     p.add_argument("--altitude", type=float)
     p.add_argument("--aod", type=float)
     p.add_argument("--width", type=int, default=1024)
+    p.add_argument("--sun", choices=("disk", "lamp"), default="disk")
     p.add_argument("--exr")
     p.add_argument("--strength", type=float, default=1.0 / LUMINOUS_EFFICACY_LM_PER_W)
     p.add_argument("--exposure", type=float)
@@ -84,6 +96,8 @@ def parse_args(argv):
 
 def envmap_url(args):
     query = {"width": args.width}
+    if args.sun == "lamp":
+        query["sun"] = "separate"
     for key, value in (("lat", args.lat), ("lon", args.lon), ("time", args.time), ("altitude", args.altitude),
                        ("aod", args.aod), ("sun_zenith", args.sun_zenith), ("sun_azimuth", args.sun_azimuth)):
         if value is not None:
@@ -102,6 +116,54 @@ def fetch(url, path, token=None):
         sys.exit(f"skyfarm_world: {url}: {e.code} {e.read().decode(errors='replace')}")
     with open(path, "wb") as f:
         f.write(data)
+
+
+def exr_attributes(path):
+    """The string, double, float and int attributes of a single-part OpenEXR
+    file's header (the file layout: magic, version, then for each attribute
+    its name and type as NUL-terminated text, a little-endian int32 size and
+    the value; a NUL ends the header).  bpy does not expose them."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if data[:4] != b"\x76\x2f\x31\x01":
+        sys.exit(f"skyfarm_world: {path} is not an OpenEXR file")
+    out, pos = {}, 8
+    while data[pos] != 0:
+        name_end = data.index(b"\0", pos)
+        type_end = data.index(b"\0", name_end + 1)
+        name, kind = data[pos:name_end].decode(), data[name_end + 1:type_end].decode()
+        (size,) = struct.unpack_from("<i", data, type_end + 1)
+        value = data[type_end + 5:type_end + 5 + size]
+        pos = type_end + 5 + size
+        if kind == "string":
+            out[name] = value.decode(errors="replace")
+        elif kind == "double":
+            out[name] = struct.unpack("<d", value)[0]
+        elif kind == "float":
+            out[name] = struct.unpack("<f", value)[0]
+        elif kind == "int":
+            out[name] = struct.unpack("<i", value)[0]
+    return out
+
+
+def add_sun_lamp(scene, attributes):
+    """A Sun lamp for the disk left out of the map (sun=separate); returns
+    the horizontal illuminance it gives, lux."""
+    rgb = [attributes[f"skyfarm:sun_disk_{c}"] for c in "RGB"]
+    peak = max(rgb)
+    direction = mathutils.Vector([float(v) for v in attributes["skyfarm:sun_direction"].split(",")]).normalized()
+    data = bpy.data.lights.new("skyfarm sun", type="SUN")
+    if peak > 0.0:
+        data.color = [c / peak for c in rgb]
+    # Per channel irradiance = radiance x solid angle, in Blender's W/m^2 (/ 683).
+    data.energy = peak * attributes["skyfarm:sun_disk_solid_angle_sr"] / LUMINOUS_EFFICACY_LM_PER_W
+    data.angle = math.radians(2.0 * attributes["skyfarm:sun_angular_radius_deg"])
+    lamp = bpy.data.objects.new("skyfarm sun", data)
+    lamp["skyfarm"] = True
+    # A Sun lamp shines along its local -Z: point +Z at the sun.
+    lamp.rotation_euler = direction.to_track_quat("Z", "Y").to_euler()
+    scene.collection.objects.link(lamp)
+    return attributes["skyfarm:sun_disk_illuminance_lux"] * max(0.0, direction.z)
 
 
 def set_linear(image):
@@ -184,6 +246,8 @@ def main(argv):
     build_world(scene, image, args.strength)
 
     e_h = latlong_horizontal_illuminance(image)
+    if args.sun == "lamp":
+        e_h += add_sun_lamp(scene, exr_attributes(path))
     exposure = args.exposure
     if exposure is None:
         # An 18 % grey card lying flat: 0.18 E_h / pi cd/m^2, times the strength.

@@ -3,7 +3,8 @@
 physical units.
 
 Starts skyfarm-server (one local worker) on free ports, then for a morning
-and an afternoon sun over Paris runs headless Blender with
+and an afternoon sun over Paris (and the afternoon again with the sun as a
+Sun lamp, --sun lamp) runs headless Blender with
 scripts/blender/skyfarm_world.py (the World from GET /v1/sky/envmap.exr)
 and grey_ball_scene.py (a grey ball under an orthographic camera looking
 down, rendered with Cycles, measured), and checks:
@@ -41,9 +42,10 @@ import urllib.parse
 import urllib.request
 
 PLACE = {"lat": 48.85, "lon": 2.35}
-CASES = [  # (name, time): the sun's azimuth comes from the server
-    ("morning", "2026-06-21T08:00:00+02:00"),
-    ("afternoon", "2026-06-21T17:00:00+02:00"),
+CASES = [  # (name, time, sun): the sun's azimuth comes from the server
+    ("morning", "2026-06-21T08:00:00+02:00", "disk"),
+    ("afternoon", "2026-06-21T17:00:00+02:00", "disk"),
+    ("afternoon-lamp", "2026-06-21T17:00:00+02:00", "lamp"),
 ]
 WIDTH = 256
 ORIENTATION_TOLERANCE_DEG = 20.0
@@ -83,7 +85,7 @@ def main():
     base = f"http://127.0.0.1:{http}"
     failures = []
     try:
-        for name, when in CASES:
+        for name, when, sun_as in CASES:
             # The sun's position, from the same service (also waits for the server to listen).
             query = urllib.parse.urlencode({**PLACE, "time": when, "view_zenith": 0, "view_azimuth": 0})
             deadline = time.monotonic() + 30
@@ -105,7 +107,7 @@ def main():
                    "-P", os.path.join(args.source, "scripts/blender/skyfarm_world.py"),
                    "-P", os.path.join(args.source, "tests/dcc/grey_ball_scene.py"),
                    "--", "--server", base, "--lat", str(PLACE["lat"]), "--lon", str(PLACE["lon"]),
-                   "--time", when, "--width", str(WIDTH), "--exr", os.path.join(out, "sky.exr")]
+                   "--time", when, "--width", str(WIDTH), "--sun", sun_as, "--exr", os.path.join(out, "sky.exr")]
             start = time.monotonic()
             run = subprocess.run(cmd, capture_output=True, text=True, timeout=150,
                                  env={**env, "SKYFARM_DCC_OUT": out, "SKYFARM_DCC_RESULT": result_path})
@@ -132,6 +134,8 @@ def main():
                 failures.append(f"{name}: 683 x top = {got_top:.0f}, albedo/pi E_h = {want_top:.0f}")
             if abs(exposed / r["albedo"] - 1.0) > BRIGHTNESS_TOLERANCE:
                 failures.append(f"{name}: exposed top {exposed:.3f}, want {r['albedo']}")
+            if r["sun_lamps"] != (1 if sun_as == "lamp" else 0):
+                failures.append(f"{name}: {r['sun_lamps']} sun lamps with --sun {sun_as}")
             if abs(r["script_horizontal_illuminance_lux"] / e_h - 1.0) > 0.01:
                 failures.append(f"{name}: the script's E_h {r['script_horizontal_illuminance_lux']:.0f} != {e_h:.0f}")
     finally:

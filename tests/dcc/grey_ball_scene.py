@@ -14,7 +14,9 @@ Measured:
   horizontal_illuminance_lux
                  the World map's cosine-weighted luminance over the upper
                  hemisphere, integrated here (pixel centres' cosines, each
-                 pixel's exact solid angle), sun included
+                 pixel's exact solid angle), sun included; plus, for each
+                 Sun lamp, 683 x strength x luminance of its colour x the
+                 cosine of its direction from the zenith
   top_display    the same pixels in a PNG written with the scene's view
                  transform and exposure (0-1, display encoded)
 """
@@ -56,8 +58,9 @@ def horizontal_illuminance(image):
 
 
 def build_scene(scene):
-    for obj in list(bpy.data.objects):
-        bpy.data.objects.remove(obj, do_unlink=True)
+    for obj in list(bpy.data.objects):  # the startup scene's; not the World script's sun lamp
+        if not obj.get("skyfarm"):
+            bpy.data.objects.remove(obj, do_unlink=True)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(0.0, 0.0, 0.0))
     ball = bpy.context.active_object
     bpy.ops.object.shade_smooth()
@@ -129,11 +132,18 @@ def main():
     top_display = sum(display[k + 1] for k in block) / len(block)
 
     world_image = next(n.image for n in scene.world.node_tree.nodes if n.type == "TEX_ENVIRONMENT")
+    e_h = horizontal_illuminance(world_image)
+    lamps = [obj for obj in scene.objects if obj.type == "LIGHT" and obj.data.type == "SUN"]
+    for lamp in lamps:
+        toward_sun = lamp.matrix_world.to_3x3().col[2].normalized()  # the lamp shines along -Z
+        colour = sum(w * c for w, c in zip(REC709_Y, lamp.data.color))
+        e_h += 683.0 * lamp.data.energy * colour * max(0.0, toward_sun.z)
     result = {
         "centroid_deg": centroid_deg,
         "top": top,
         "top_display": top_display,
-        "horizontal_illuminance_lux": horizontal_illuminance(world_image),
+        "horizontal_illuminance_lux": e_h,
+        "sun_lamps": len(lamps),
         "script_horizontal_illuminance_lux": scene.get("skyfarm_horizontal_illuminance_lux"),
         "strength": next(n for n in scene.world.node_tree.nodes if n.type == "BACKGROUND").inputs["Strength"].default_value,
         "exposure": scene.view_settings.exposure,
