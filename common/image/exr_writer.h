@@ -90,7 +90,7 @@ struct ExrWriteOptions {
   bool latlong_envmap = false;
   ColorSpace color_space = ColorSpace::kLinRec709;
   RadiometricUnits units = RadiometricUnits::kCdM2;
-  std::optional<double> exposure_ev;
+  std::optional<double> exposure_ev = std::nullopt;
 };
 
 struct ExrWriteReport {
