@@ -35,7 +35,7 @@ constexpr std::string_view kCommonParams[] = {"lat",     "lon",     "altitude", 
                                               "sun_azimuth", "preset", "ozone_du", "aod",  "aerosol",
                                               "albedo",  "min_nm",  "max_nm"};
 constexpr std::string_view kLookupParams[] = {"view_zenith", "view_azimuth"};
-constexpr std::string_view kEnvmapParams[] = {"width", "sun"};
+constexpr std::string_view kEnvmapParams[] = {"width", "sun", "color_space", "units"};
 
 // The probe's field paths -> the query parameters they came from.
 struct PathName {
@@ -251,6 +251,20 @@ SkyQuery parse_sky_query(const QueryParams& params, SkyRoute route, int base_spe
       else if (*s == "separate") out.sun_mode = EnvmapSun::kSeparate;
       else q.error("sun", "must be one of disk, none, separate", quote_value(*s));
     }
+    // The names of the render request's output.color_space / output.units.
+    auto names_of = [](const auto& names) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.first);
+      return list;
+    };
+    if (const auto c = q.text("color_space")) {
+      if (const auto v = color_space_named(*c)) out.color_space = *v;
+      else q.error("color_space", "must be one of " + names_of(kColorSpaceNames), quote_value(*c));
+    }
+    if (const auto u = q.text("units")) {
+      if (const auto v = units_named(*u)) out.units = *v;
+      else q.error("units", "must be one of " + names_of(kRadiometricUnitsNames), quote_value(*u));
+    }
   }
 
   std::optional<api::ProbeRequest> probe;
@@ -336,6 +350,9 @@ Json SkyQuery::canonical_json(SkyRoute route) const {
   } else {
     j["width"] = width;
     j["sun_mode"] = sun_mode_name(sun_mode);
+    // Only when not the default: the maps of before keep their key and ETag.
+    if (color_space != ColorSpace::kLinRec709) j["color_space"] = std::string(name_of(color_space));
+    if (units != RadiometricUnits::kCdM2) j["units"] = std::string(name_of(units));
   }
   return j;
 }
@@ -417,7 +434,7 @@ void SkyHttp::envmap(const httplib::Request& req, httplib::Response& res) const 
       const glm::dvec3& d = table->sun.direction();
       image.set_metadata("sun_direction", exact_decimal(d.x) + "," + exact_decimal(d.y) + "," + exact_decimal(d.z));
     }
-    return encode_envmap_exr(image);
+    return encode_envmap_exr(image, q.color_space, q.units);
   });
   if (not_modified(req, res, file->etag, cache_control_)) return;
   res.status = 200;

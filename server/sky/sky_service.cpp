@@ -263,7 +263,7 @@ Image render_envmap(const SkyTable& table, int width, EnvmapSun sun_mode, int th
   return image;
 }
 
-std::string encode_envmap_exr(const Image& image) {
+std::string encode_envmap_exr(const Image& image, ColorSpace color_space, RadiometricUnits units) {
   namespace fs = std::filesystem;
   const fs::path path = fs::temp_directory_path() / ("skyfarm-envmap-" + std::to_string(::getpid()) + "-" +
                                                       std::to_string(g_temp_counter.fetch_add(1)) + ".exr");
@@ -276,6 +276,8 @@ std::string encode_envmap_exr(const Image& image) {
   // one thread here).
   options.compression = ExrCompression::kPiz;
   options.latlong_envmap = true;
+  options.color_space = color_space;
+  options.units = units;  // relative: the map's own automatic exposure
   struct Remove {
     fs::path p;
     ~Remove() {

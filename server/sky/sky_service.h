@@ -57,6 +57,7 @@
 
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/film/image.h"
+#include "common/image/color_management.h"
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
 #include "common/spectrum/color.h"
@@ -133,8 +134,10 @@ SunDiskSummary sun_disk_summary(const SkyTable& table, int samples = 64);
 Image render_envmap(const SkyTable& table, int width, EnvmapSun sun, int threads = 0);
 
 // The image as a FLOAT, PIZ-compressed (lossless) OpenEXR with the latlong envmap
-// attribute, as bytes (written through a temporary file).
-std::string encode_envmap_exr(const Image& image);
+// attribute, as bytes (written through a temporary file); R, G, B in the
+// colour space and units asked for (exr_writer.h).
+std::string encode_envmap_exr(const Image& image, ColorSpace color_space = ColorSpace::kLinRec709,
+                              RadiometricUnits units = RadiometricUnits::kCdM2);
 
 // --- The caches ----------------------------------------------------------------
 
