@@ -15,6 +15,7 @@
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera_spec.h"
 #include "common/clouds/cloud_spec.h"
+#include "common/image/color_management.h"
 #include "common/objects/object_spec.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
@@ -56,6 +57,10 @@ struct OutputSpec {
   bool spectral_channels = false;     // one EXR channel per wavelength batch
   bool error_layer = false;           // relative standard error per pixel
   bool half = true;                   // EXR half floats (else 32-bit floats)
+  // Colour management at write time (common/image/color_management.h).
+  ColorSpace color_space = ColorSpace::kLinRec709;  // EXR RGB primaries
+  RadiometricUnits units = RadiometricUnits::kCdM2;  // EXR RGB units
+  DisplayView view = DisplayView::kSrgb;             // PNG view
 };
 
 // A validated render request, every default filled in.

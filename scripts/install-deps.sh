@@ -14,6 +14,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libembree-dev               # the BVH over the scene's triangles (common/accel)
   libassimp-dev               # mesh assets' import (common/assets/mesh_import.h)
+  libopencolorio-dev          # colour spaces and filmic views of the images (common/image/color_management.h)
   libopenvdb-dev              # cloud volumes' import (common/assets/vdb_import.h); its headers
   libboost-dev libboost-iostreams-dev  # and CMake module need Boost, which it does not pull in
   ffmpeg

@@ -35,7 +35,7 @@ constexpr std::string_view kCommonParams[] = {"lat",     "lon",     "altitude", 
                                               "sun_azimuth", "preset", "ozone_du", "aod",  "aerosol",
                                               "albedo",  "min_nm",  "max_nm"};
 constexpr std::string_view kLookupParams[] = {"view_zenith", "view_azimuth"};
-constexpr std::string_view kEnvmapParams[] = {"width", "sun", "layout"};
+constexpr std::string_view kEnvmapParams[] = {"width", "sun", "layout", "color_space", "units"};
 
 // The probe's field paths -> the query parameters they came from.
 struct PathName {
@@ -267,6 +267,20 @@ SkyQuery parse_sky_query(const QueryParams& params, SkyRoute route, int base_spe
     if (out.layout == EnvmapLayout::kEqualArea && out.width > kEnvmapMaxWidthEqualArea)
       q.error("width", "must be at most " + std::to_string(kEnvmapMaxWidthEqualArea) + " with layout=equal_area",
               std::to_string(out.width));
+    // The names of the render request's output.color_space / output.units.
+    auto names_of = [](const auto& names) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.first);
+      return list;
+    };
+    if (const auto c = q.text("color_space")) {
+      if (const auto v = color_space_named(*c)) out.color_space = *v;
+      else q.error("color_space", "must be one of " + names_of(kColorSpaceNames), quote_value(*c));
+    }
+    if (const auto u = q.text("units")) {
+      if (const auto v = units_named(*u)) out.units = *v;
+      else q.error("units", "must be one of " + names_of(kRadiometricUnitsNames), quote_value(*u));
+    }
   }
 
   std::optional<api::ProbeRequest> probe;
@@ -353,6 +367,9 @@ Json SkyQuery::canonical_json(SkyRoute route) const {
     j["width"] = width;
     j["sun_mode"] = sun_mode_name(sun_mode);
     if (layout == EnvmapLayout::kEqualArea) j["layout"] = "equal_area";
+    // Only when not the default: the maps of before keep their key and ETag.
+    if (color_space != ColorSpace::kLinRec709) j["color_space"] = std::string(name_of(color_space));
+    if (units != RadiometricUnits::kCdM2) j["units"] = std::string(name_of(units));
   }
   return j;
 }
@@ -438,7 +455,7 @@ void SkyHttp::envmap(const httplib::Request& req, httplib::Response& res) const 
       const glm::dvec3& d = table->sun.direction();
       image.set_metadata(mk::kSunDirection, exact_decimal(d.x) + "," + exact_decimal(d.y) + "," + exact_decimal(d.z));
     }
-    return encode_envmap_exr(image, latlong);
+    return encode_envmap_exr(image, latlong, q.color_space, q.units);
   });
   if (not_modified(req, res, file->etag, cache_control_)) return;
   res.status = 200;

@@ -28,11 +28,16 @@
 //   envmap only:    width, even, [8, 8192], default 1024 (height = width / 2);
 //                   at most 1024 for an observer above the atmosphere's top
 //                   (100 km), where every pixel is a ray march (~3 s at 1024);
-//                   sun = disk (default) | none | separate
+//                   sun = disk (default) | none | separate;
 //                   layout = latlong (default) | equal_area: a width x width
 //                   square in the equal-area octahedral mapping of pbrt-v4's
 //                   `imagemap` infinite light (sky_service.h), width at most
-//                   4096
+//                   4096;
+//                   color_space = lin_rec709 (default) | acescg | aces2065-1
+//                   | cie_xyz and units = cd_m2 (default) | relative |
+//                   w_m2_sr, as the render request's output.color_space and
+//                   output.units (common/image/color_management.h; relative
+//                   meters the map's own median luminance)
 // Anything else is a 400 naming the unknown parameter; every invalid value
 // is a 400 problem whose errors[].field is the query parameter's name.
 //
@@ -68,7 +73,9 @@
 //              sun_disk_solid_angle_sr, sun_disk_illuminance_lux (normal
 //              illuminance from the disk), sun_direction ("x,y,z" in the
 //              observer frame: x east, y north, z up) - what a renderer needs
-//              for a distant light.
+//              for a distant light.  These stay linear Rec.709 / XYZ in
+//              cd/m^2 whatever color_space and units say; skyfarm:units_scale
+//              converts them.
 //
 // Both: strong ETag (a hash of the body), If-None-Match -> 304, and
 // Cache-Control "public, max-age=3600" ("private, max-age=3600" when the API
@@ -84,6 +91,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/atmosphere/atmosphere_spec.h"
+#include "common/image/color_management.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
 #include "server/sky/sky_service.h"
@@ -120,6 +128,8 @@ struct SkyQuery {
   int width = kEnvmapDefaultWidth;                        // envmap
   EnvmapSun sun_mode = EnvmapSun::kDisk;                  // envmap
   EnvmapLayout layout = EnvmapLayout::kLatlong;           // envmap
+  ColorSpace color_space = ColorSpace::kLinRec709;        // envmap
+  RadiometricUnits units = RadiometricUnits::kCdM2;       // envmap
   // What the table is built from: the sun resolved (from time, or the angles).
   SkyTableParams table;
 

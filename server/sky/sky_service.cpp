@@ -324,7 +324,7 @@ Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun_m
   return image;
 }
 
-std::string encode_envmap_exr(const Image& image, bool latlong) {
+std::string encode_envmap_exr(const Image& image, bool latlong, ColorSpace color_space, RadiometricUnits units) {
   namespace fs = std::filesystem;
   const fs::path path = fs::temp_directory_path() / ("skyfarm-envmap-" + std::to_string(::getpid()) + "-" +
                                                       std::to_string(g_temp_counter.fetch_add(1)) + ".exr");
@@ -337,6 +337,8 @@ std::string encode_envmap_exr(const Image& image, bool latlong) {
   // one thread here).
   options.compression = ExrCompression::kPiz;
   options.latlong_envmap = latlong;
+  options.color_space = color_space;
+  options.units = units;  // relative: the map's own automatic exposure
   struct Remove {
     fs::path p;
     ~Remove() {

@@ -65,6 +65,7 @@
 
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/film/image.h"
+#include "common/image/color_management.h"
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
 #include "common/spectrum/color.h"
@@ -148,8 +149,11 @@ Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun, 
 
 // The image as a FLOAT, PIZ-compressed (lossless) OpenEXR, as bytes (written
 // through a temporary file); `latlong`: with the standard `envmap` attribute
-// LATLONG (OpenEXR has no name for the equal-area layout).
-std::string encode_envmap_exr(const Image& image, bool latlong = true);
+// LATLONG (OpenEXR has no name for the equal-area layout); R, G, B in the
+// colour space and units asked for (exr_writer.h).
+std::string encode_envmap_exr(const Image& image, bool latlong = true,
+                              ColorSpace color_space = ColorSpace::kLinRec709,
+                              RadiometricUnits units = RadiometricUnits::kCdM2);
 
 // --- The caches ----------------------------------------------------------------
 

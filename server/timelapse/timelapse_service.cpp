@@ -249,6 +249,7 @@ void TimelapseService::build_outputs(const std::string& id) {
     const Entry& t = *timelapses_.at(id);
     settings.fixed_ev100 = t.request.base.output.exposure_ev;
     settings.smoothing_frames = t.request.exposure_smoothing_frames;
+    settings.view = t.request.base.output.view;
     settings.fps = t.request.video_fps;
     settings.ffmpeg = options_.ffmpeg;
     settings.ffmpeg_timeout = options_.ffmpeg_timeout;
