@@ -183,6 +183,50 @@ TEST_F(WebConsole, ListShowsNamesFiltersByStateShowsTheRequestAndDuplicates) {
   EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
 }
 
+// A timelapse: listed by name; selecting it shows its request; Duplicate
+// switches the form to a timelapse with its start, end and frames.
+TEST_F(WebConsole, TimelapseIsListedByNameAndDuplicatesIntoTheForm) {
+  FarmServer& server = *server_;
+  WebDriver& driver = *driver_;
+  const auto res = server.client().Post("/v1/timelapses", R"({"name": "Paris afternoon", "method": "lut",
+    "location": {"latitude_deg": 48.85, "longitude_deg": 2.35},
+    "start": "2021-06-21T12:00:00+02:00", "end": "2021-06-21T14:00:00+02:00", "frames": 3,
+    "camera": {"projection": "equirectangular", "width": 16, "height": 8}})", "application/json");
+  ASSERT_TRUE(res);
+  ASSERT_EQ(res->status, 202) << res->body;
+  const std::string id = nlohmann::json::parse(res->body)["id"];
+  open_page();
+  const std::string row = "document.querySelector(" + js_string("#timelapses-body tr[data-key=\"" + id + "\"]") + ")";
+  ASSERT_TRUE(driver.wait_until("return !!" + row + ";", kPageTimeout)) << driver.log();
+  EXPECT_EQ(driver.execute("return " + row + ".querySelector('.job-link').textContent;"), "Paris afternoon");
+  EXPECT_EQ(driver.execute("return " + row + ".querySelector('.job-meta').textContent;"),
+            "48.85° N, 2.35° E · 2021-06-21 12:00 +02:00 to 2021-06-21 14:00 +02:00 · lut · equirectangular 16×8");
+  driver.click(driver.find("#timelapses-body tr[data-key=\"" + id + "\"] a.job-link"));
+  ASSERT_TRUE(driver.wait_until("return document.querySelector('#tl-request').textContent.length > 0 &&"
+                                " !document.querySelector('#tl-duplicate').disabled;",
+                                kPageTimeout))
+      << driver.log();
+  EXPECT_EQ(text_of(driver, "#tl-name"), "Paris afternoon");
+  const nlohmann::json shown = nlohmann::json::parse(text_of(driver, "#tl-request"));
+  EXPECT_EQ(shown["name"], "Paris afternoon");
+  EXPECT_EQ(shown["frames"], 3);
+  driver.click(driver.find("#tl-duplicate"));
+  EXPECT_EQ(driver.execute("return document.body.dataset.kind;"), "timelapse");
+  const auto value = [&](const std::string& css) {
+    return driver.execute("return document.querySelector(arguments[0]).value;", {css}).get<std::string>();
+  };
+  EXPECT_EQ(value("#name"), "Paris afternoon");
+  EXPECT_EQ(value("#time-local").substr(0, 16), "2021-06-21T12:00");
+  EXPECT_EQ(value("#time-end").substr(0, 16), "2021-06-21T14:00");
+  EXPECT_EQ(value("#time-zone"), "+02:00");
+  EXPECT_EQ(value("#split-kind"), "frames");
+  EXPECT_EQ(value("#split-value"), "3");
+  EXPECT_EQ(value("#method"), "lut");
+  EXPECT_EQ(nlohmann::json::parse(value("#request-json")), shown);
+  const std::string log = driver.log();
+  EXPECT_EQ(log.find("Uncaught"), std::string::npos) << log;
+}
+
 TEST_F(WebConsole, DrainButtonDrainsTheWorkerAndResumeUndoesIt) {
   FarmServer& server = *server_;
   WebDriver& driver = *driver_;
