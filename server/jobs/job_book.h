@@ -78,7 +78,8 @@ struct JobBook {
   std::vector<std::pair<std::string, std::uint64_t>> cancelled;  // (worker, attempt) to stop
   std::map<std::string, WorkerInfo> workers;
   // Workers an operator drained (POST /v1/workers/{id}/drain): they get no
-  // new units until resumed, even after they reconnect under the same id.
+  // new units until resumed, even after they reconnect under the same id
+  // (not persisted: a restarted server has every worker working).
   std::set<std::string> drained_workers;
   std::int64_t next_sequence = 1;
   std::uint64_t unit_failures = 0, requeues = 0, results_refused = 0;

@@ -45,9 +45,10 @@ nlohmann::json JobBook::status_of(const Job& job) const {
           {"progress",
            {{"fraction", fraction},
             {"samples_per_pixel", spp},
-            // The sample cap (quality.samples_per_pixel; 1048576 when only a
-            // target error or a time limit stops the render).
-            {"samples_per_pixel_target", job.request.quality.samples_per_pixel},
+            // The samples per pixel the plan stops at: quality.samples_per_pixel
+            // for the path tracer (1048576 when only a target error or a time
+            // limit stops the render), 1 for the LUT renderer's single pass.
+            {"samples_per_pixel_target", job.plan.samples_after(job.plan.passes)},
             {"units_done", merged},
             {"units_total", total}}},
           {"elapsed_s", elapsed},

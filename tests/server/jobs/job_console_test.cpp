@@ -67,6 +67,10 @@ TEST(JobConsole, TheNameIsReportedWithTheRequestAndSurvivesARestart) {
     EXPECT_EQ(again.id, id);
     EXPECT_FALSE(again.created);
     EXPECT_EQ((*service.status(id))["name"], "Ithaca dusk");
+    // A LUT render is one pass of one sample: its target is 1, not the 64 of its quality.
+    api::RenderRequest lut = api::parse_render_request(kPlain);
+    lut.method = api::Method::kLut;
+    EXPECT_EQ((*service.status(service.submit(lut, std::nullopt).id))["progress"]["samples_per_pixel_target"], 1);
     // Unnamed: null.
     api::RenderRequest other = api::parse_render_request(kPlain);
     other.seed = 2;
