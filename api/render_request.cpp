@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "api/cloud_fields.h"
+#include "api/job_name.h"
 #include "api/object_fields.h"
 
 namespace skyfarm::api {
@@ -182,7 +183,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   if (!body.is_object()) throw ValidationError({FieldError{"", "must be a JSON object", value_text(body)}});
   Fields top(body, "", e);
   top.allow_only({"location", "time", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output",
-                  "seed", "priority", "objects", "clouds"});
+                  "seed", "priority", "objects", "clouds", "name"});
   RenderRequest r;
   read_location(top, r.location);
   read_time(top, r.time, r.time_text);
@@ -198,6 +199,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   read_output(top, r.output);
   read_seed(top, r.seed);
   top.integer("priority", 0, 100, r.priority);
+  read_job_name(top, r.name);
   if (r.method == Method::kLut && !r.objects.empty())
     e.add("objects", "the lut method renders the sky alone: objects need \"method\": \"path\"");
   // The LUT renderer ray-marches cloud layers; placed volumes need the path tracer.

@@ -79,6 +79,9 @@ struct RenderRequest {
   OutputSpec output;
   std::uint64_t seed = 1;
   int priority = 50;
+  // A label (api/job_name.h), never in the canonical request: it does not
+  // change what is rendered, so it changes neither the hash nor the EXR.
+  std::optional<std::string> name;
 };
 
 // Parses and validates a request body.  Throws ValidationError listing every
@@ -94,7 +97,8 @@ inline RenderRequest parse_render_request(const char* json_text) {
 
 // Every field with its default filled in and equivalent spellings unified
 // (docs/request-schema.md "Canonical form"): requests that mean the same give
-// the same to_canonical_json(r).dump(); parsing it gives the same request back.
+// the same to_canonical_json(r).dump(); parsing it gives the same request back
+// (but for "name", which is left out: it labels a render, it is not rendered).
 nlohmann::json to_canonical_json(const RenderRequest& request);
 // to_canonical_json(request).dump(): the text the farm hashes.
 std::string canonical_text(const RenderRequest& request);

@@ -29,8 +29,10 @@ Image::Image(int width, int height, ImageLayers layers)
   }
   rgb_.assign(pixel_count() * 3, 0.0f);
   if (layers.relative_error) error_.assign(pixel_count(), kUnknownError);
-  metadata_[metadata_key::kSoftwareVersion] = std::string(SKYFARM_VERSION);
+  metadata_[metadata_key::kSoftwareVersion] = software_version_text();
 }
+
+std::string software_version_text() { return std::string("skyfarm ") + SKYFARM_VERSION; }
 
 std::size_t Image::offset(int x, int y) const {
   if (x < 0 || y < 0 || x >= width_ || y >= height_)

@@ -28,8 +28,8 @@
 //
 // Metadata: string → string or number, written by the EXR writer as
 // "skyfarm:<key>" attributes and by the PNG writer as text chunks.  The
-// constructor sets kSoftwareVersion; the keys below are the ones the server
-// fills (any other key is allowed).
+// constructor sets kSoftwareVersion (software_version_text()); the keys below
+// are the project's vocabulary (docs/exr-metadata.md).
 #pragma once
 #include <array>
 #include <cstddef>
@@ -58,21 +58,67 @@ struct ImageLayers {
 
 using MetadataValue = std::variant<std::string, double>;
 
-// Well-known metadata keys.
+// The metadata vocabulary: every key any skyfarm output writes, one name per
+// quantity.  docs/exr-metadata.md lists them with their types, units and
+// which outputs carry them (renders, sky env maps, timelapse frames, the
+// worker's local `render`); tests/farm/farm_exr_metadata_test.cpp checks the
+// files against that list.  Call sites use these constants, never literals.
 namespace metadata_key {
+// --- Every image (a render, an env map, a frame) ---------------------------
 inline constexpr const char kRequest[] = "request";                  // canonical request JSON
 inline constexpr const char kSunZenithDeg[] = "sun_zenith_deg";
 inline constexpr const char kSunAzimuthDeg[] = "sun_azimuth_deg";
-inline constexpr const char kSamplesPerPixel[] = "samples_per_pixel";
 inline constexpr const char kWavelengthMinNm[] = "wavelength_min_nm";
 inline constexpr const char kWavelengthMaxNm[] = "wavelength_max_nm";
-inline constexpr const char kSoftwareVersion[] = "software_version";
+inline constexpr const char kSoftwareVersion[] = "software_version";  // software_version_text()
+inline constexpr const char kMethod[] = "method";                     // "path" or "lut"
+inline constexpr const char kEarthSunDistanceAu[] = "earth_sun_distance_au";
+// --- Renders (farm and worker-local) ----------------------------------------
+inline constexpr const char kSamplesPerPixel[] = "samples_per_pixel";
 inline constexpr const char kEstimatedRelativeRms[] = "estimated_relative_rms";
 // Per linear sRGB channel (error_estimate.h).
 inline constexpr const char kEstimatedRelativeRmsR[] = "estimated_relative_rms_r";
 inline constexpr const char kEstimatedRelativeRmsG[] = "estimated_relative_rms_g";
 inline constexpr const char kEstimatedRelativeRmsB[] = "estimated_relative_rms_b";
+// LUT renders and env maps: why the image is not the path tracer's.
+inline constexpr const char kApproximate[] = "approximate";
+// --- Sky env maps (/v1/sky/envmap.exr) ---------------------------------------
+// Deprecated alias of kEarthSunDistanceAu, still written next to it: the
+// API documented it before the vocabulary was one.
+inline constexpr const char kSunEarthDistanceAuDeprecated[] = "sun_earth_distance_au";
+inline constexpr const char kSunAngularRadiusDeg[] = "sun_angular_radius_deg";
+inline constexpr const char kSunMode[] = "sun_mode";
+inline constexpr const char kObserverAltitudeM[] = "observer_altitude_m";
+inline constexpr const char kLayout[] = "layout";
+inline constexpr const char kSunDiskX[] = "sun_disk_X";
+inline constexpr const char kSunDiskY[] = "sun_disk_Y";
+inline constexpr const char kSunDiskZ[] = "sun_disk_Z";
+inline constexpr const char kSunDiskR[] = "sun_disk_R";
+inline constexpr const char kSunDiskG[] = "sun_disk_G";
+inline constexpr const char kSunDiskB[] = "sun_disk_B";
+inline constexpr const char kSunDiskSolidAngleSr[] = "sun_disk_solid_angle_sr";
+inline constexpr const char kSunDiskIlluminanceLux[] = "sun_disk_illuminance_lux";
+inline constexpr const char kSunDirection[] = "sun_direction";
+// --- Timelapse frame PNGs ------------------------------------------------------
+inline constexpr const char kTimelapseFrameIndex[] = "timelapse_frame_index";
+inline constexpr const char kTimelapseFrameTime[] = "timelapse_frame_time";
+// The timelapse contact sheet PNG (no Image: its own two keys).
+inline constexpr const char kContactSheetFrames[] = "contact_sheet_frames";
+inline constexpr const char kContactSheetColumns[] = "contact_sheet_columns";
+// --- Written by the file writers themselves (exr_writer.h, png_writer.h) -----
+inline constexpr const char kHalfClampedValues[] = "half_clamped_values";
+inline constexpr const char kSpectralBandEdgesNm[] = "spectral_band_edges_nm";
+inline constexpr const char kErrorChannel[] = "error.Y";               // the error layer's description
+inline constexpr const char kExposureEv100[] = "exposure_ev100";       // PNG only
+inline constexpr const char kExposureScale[] = "exposure_scale";       // PNG only
 }  // namespace metadata_key
+
+// Every key is written with this prefix: an EXR attribute "skyfarm:<key>",
+// a PNG iTXt keyword "skyfarm:<key>" (standard attributes have none).
+inline constexpr char kMetadataPrefix[] = "skyfarm:";
+
+// kSoftwareVersion's value in every output: "skyfarm <version>".
+std::string software_version_text();
 
 class Image {
  public:

@@ -155,7 +155,7 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
     header.insert(std::string(kExrMetadataPrefix) + "units_scale", Imf::DoubleAttribute(units_factor));
   }
   if (options.half)
-    header.insert(std::string(kExrMetadataPrefix) + "half_clamped_values",
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kHalfClampedValues,
                   Imf::DoubleAttribute(static_cast<double>(report.clamped_half_values)));
 
   Imf::ChannelList& channels = header.channels();
@@ -171,11 +171,11 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
     edges += shortest(image.band_range(image.spectral_batches() - 1).max_nm);
     header.insert("spectralLayoutVersion", Imf::StringAttribute(kSpectralLayoutVersion));
     header.insert("emissiveUnits", Imf::StringAttribute(kSpectralEmissiveUnits));
-    header.insert(std::string(kExrMetadataPrefix) + "spectral_band_edges_nm", Imf::StringAttribute(edges));
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kSpectralBandEdgesNm, Imf::StringAttribute(edges));
   }
   if (error_layer) {
     channels.insert(kExrErrorChannel, Imf::Channel(Imf::FLOAT));
-    header.insert(std::string(kExrMetadataPrefix) + kExrErrorChannel,
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kErrorChannel,
                   Imf::StringAttribute("relative standard error of the pixel luminance, sqrt(Var[Y])/Y; "
                                        "+inf where the pixel has no estimate yet"));
   }

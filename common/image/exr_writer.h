@@ -98,7 +98,7 @@ struct ExrWriteReport {
   std::size_t clamped_half_values = 0;
 };
 
-inline constexpr char kExrMetadataPrefix[] = "skyfarm:";
+inline constexpr const char* kExrMetadataPrefix = kMetadataPrefix;  // image.h
 inline constexpr char kExrErrorChannel[] = "error.Y";
 inline constexpr char kSpectralLayoutVersion[] = "1.0";
 inline constexpr char kSpectralEmissiveUnits[] = "W.m^-2.sr^-1";

@@ -224,10 +224,10 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   std::vector<std::pair<std::string, std::string>> entries;
   for (const auto& [key, value] : image.metadata()) {
     const auto* s = std::get_if<std::string>(&value);
-    entries.emplace_back(png_keyword("skyfarm:" + key), s ? *s : shortest(std::get<double>(value)));
+    entries.emplace_back(png_keyword(kMetadataPrefix + key), s ? *s : shortest(std::get<double>(value)));
   }
-  entries.emplace_back("skyfarm:exposure_ev100", shortest(report.exposure_ev));
-  entries.emplace_back("skyfarm:exposure_scale", shortest(report.scale));
+  entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureEv100, shortest(report.exposure_ev));
+  entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureScale, shortest(report.scale));
   // Only a non-default view is named: the default's bytes stay as they were.
   if (options.view != DisplayView::kSrgb) entries.emplace_back("skyfarm:view", std::string(name_of(options.view)));
   write_png_rows(path, w, h, options.bit_depth, rows.data(), entries);

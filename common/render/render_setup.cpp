@@ -105,17 +105,18 @@ void set_render_metadata(Image* image, std::string_view canonical_request, const
   image->set_metadata(key::kSamplesPerPixel, static_cast<double>(samples_per_pixel));
   image->set_metadata(key::kWavelengthMinNm, plan.lambda_min_nm);
   image->set_metadata(key::kWavelengthMaxNm, plan.lambda_max_nm);
-  image->set_metadata(key::kSoftwareVersion, std::string("skyfarm ") + SKYFARM_VERSION);
+  image->set_metadata(key::kSoftwareVersion, software_version_text());
   if (const auto e = error.relative_rms()) image->set_metadata(key::kEstimatedRelativeRms, *e);
   if (const auto e = error.relative_rms_rgb()) {
     image->set_metadata(key::kEstimatedRelativeRmsR, e->r);
     image->set_metadata(key::kEstimatedRelativeRmsG, e->g);
     image->set_metadata(key::kEstimatedRelativeRmsB, e->b);
   }
-  image->set_metadata("method", std::string(plan.lut ? "lut" : "path"));
+  image->set_metadata(key::kMethod, std::string(plan.lut ? "lut" : "path"));
   if (plan.lut)
-    image->set_metadata("approximate", std::string("table-based sky (Hillaire 2020); error against the path tracer: README"));
-  image->set_metadata("earth_sun_distance_au", sun.distance_au());
+    image->set_metadata(key::kApproximate,
+                        std::string("table-based sky (Hillaire 2020); error against the path tracer: README"));
+  image->set_metadata(key::kEarthSunDistanceAu, sun.distance_au());
 }
 
 }  // namespace skyfarm

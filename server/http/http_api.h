@@ -56,6 +56,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -63,6 +64,7 @@
 
 #include "server/http/http_events.h"
 #include "server/http/http_metrics.h"
+#include "server/http/http_request_metrics.h"
 #include "server/http/http_backend.h"
 #include "server/probes/probe_service.h"
 #include "server/sky/sky_service.h"
@@ -148,6 +150,9 @@ class HttpApi {
   void image_png(const httplib::Request& req, httplib::Response& res);
   void events(const httplib::Request& req, httplib::Response& res);
   void workers(const httplib::Request& req, httplib::Response& res);
+  void drain_worker(const httplib::Request& req, httplib::Response& res, bool drain);
+  void thumbnail(const httplib::Request& req, httplib::Response& res);
+  ImageFile image_file(const std::string& id, ImageFormat format);
   void sky(const httplib::Request& req, httplib::Response& res);
   void sky_radiance(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
   void sky_envmap(const httplib::Request& req, httplib::Response& res);
@@ -173,11 +178,13 @@ class HttpApi {
   const HttpOptions options_;
   StreamSlots streams_;
   ResponseCounter responses_;
+  HttpRequestMetrics requests_;  // by route template, method, code; durations
   std::unique_ptr<SkyHttp> sky_;
   std::unique_ptr<TimelapseHttp> timelapses_;
   std::unique_ptr<AssetHttp> assets_;
   const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
   std::vector<Route> routes_;
+  std::mutex thumbnail_writer_;  // thumbnail files (AtomicFile: one writer of a path at a time)
 };
 
 }  // namespace skyfarm::server

@@ -1,11 +1,14 @@
 #include "server/http/http_metrics.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <set>
 #include <string_view>
 
 #include "common/core/huge_page_allocator.h"
+#include "server/http/build_info.h"
+#include "server/http/http_request_metrics.h"
 #include "server/probes/probe_service.h"
 #include "server/sky/sky_service.h"
 
@@ -35,6 +38,9 @@ constexpr KnownMetric kKnown[] = {
      "Mesh assets workers asked for that the server does not have."},
     {"disk_used_bytes", "skyfarm_disk_used_bytes", "gauge", "Bytes the data directory holds (jobs' files, database)."},
     {"disk_budget_bytes", "skyfarm_disk_budget_bytes", "gauge", "The data directory's disk budget in bytes (0: none)."},
+    {"samples_total", "skyfarm_samples_total", "counter",
+     "Samples (paths) merged into renders since the server started; rate() of it is samples per second."},
+    {"units_completed", "skyfarm_units_completed_total", "counter", "Work units merged into renders."},
 };
 constexpr std::string_view kJobsPrefix = "jobs_";
 
@@ -50,15 +56,16 @@ std::string format_value(const nlohmann::json& v) {
 }
 
 void header(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
-  out.append("# HELP ").append(name).append(" ").append(help).append("\n");
-  out.append("# TYPE ").append(name).append(" ").append(type).append("\n");
+  append_metric_header(out, name, type, help);
 }
 
 void sample(std::string& out, std::string_view name, std::string_view labels, const std::string& value) {
-  out.append(name);
-  if (!labels.empty()) out.append("{").append(labels).append("}");
-  out.append(" ").append(value).append("\n");
+  append_metric_sample(out, name, labels, value);
 }
+
+// A histogram bound as `le` shows it: the shortest text that reads back as
+// the same double ("0.005", "1", "2.5").
+std::string le_text(double bound) { return format_value(nlohmann::json(bound)); }
 
 // A metric or label-value name made of [a-zA-Z0-9_] only.
 std::string sanitized(std::string_view key) {
@@ -90,7 +97,7 @@ void append_jobs(std::string& out, const nlohmann::json& backend) {
 
 void append_others(std::string& out, const nlohmann::json& backend) {
   std::set<std::string> taken = {"skyfarm_jobs", "skyfarm_http_responses_total", "skyfarm_http_requests_total",
-                                 "skyfarm_http_event_streams"};
+                                 "skyfarm_http_event_streams", "skyfarm_build_info"};
   for (const auto& m : kKnown) {
     taken.insert(std::string(m.name));
     taken.insert("skyfarm_" + std::string(m.key));
@@ -106,6 +113,54 @@ void append_others(std::string& out, const nlohmann::json& backend) {
 
 }  // namespace
 
+void append_metric_header(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
+  out.append("# HELP ").append(name).append(" ").append(help).append("\n");
+  out.append("# TYPE ").append(name).append(" ").append(type).append("\n");
+}
+
+void append_metric_sample(std::string& out, std::string_view name, std::string_view labels, const std::string& value) {
+  out.append(name);
+  if (!labels.empty()) out.append("{").append(labels).append("}");
+  out.append(" ").append(value).append("\n");
+}
+
+std::string escaped_label_value(std::string_view value) {
+  std::string s;
+  for (const char c : value) {
+    if (c == '\\' || c == '"') s += '\\';
+    if (c == '\n') s += "\\n";
+    else s += c;
+  }
+  return s;
+}
+
+void append_histogram(std::string& out, std::string_view name, std::string_view help,
+                      const std::vector<std::pair<std::string, MetricsHistogram::Snapshot>>& series) {
+  append_metric_header(out, name, "histogram", help);
+  const std::string bucket = std::string(name) + "_bucket", sum = std::string(name) + "_sum",
+                    count = std::string(name) + "_count";
+  for (const auto& [labels, s] : series) {
+    const std::string prefix = labels.empty() ? std::string() : labels + ",";
+    for (std::size_t i = 0; i < s.cumulative.size(); ++i) {
+      const std::string le = i < s.upper_bounds.size() ? le_text(s.upper_bounds[i]) : std::string("+Inf");
+      append_metric_sample(out, bucket, prefix + "le=\"" + le + "\"", std::to_string(s.cumulative[i]));
+    }
+    append_metric_sample(out, sum, labels, format_value(nlohmann::json(s.sum)));
+    append_metric_sample(out, count, labels, std::to_string(s.count));
+  }
+}
+
+void append_build_info(std::string& out) {
+  const BuildInfo& b = build_info();
+  append_metric_header(out, "skyfarm_build_info", "gauge",
+                       "Always 1; which build serves: its version, commit, compiler and build type.");
+  append_metric_sample(out, "skyfarm_build_info",
+                       "version=\"" + escaped_label_value(b.version) + "\",git_commit=\"" +
+                           escaped_label_value(b.git_commit) + "\",compiler=\"" + escaped_label_value(b.compiler) +
+                           "\",build_type=\"" + escaped_label_value(b.build_type) + "\"",
+                       "1");
+}
+
 void ResponseCounter::count(int status) {
   if (status >= 100 && status < static_cast<int>(counts_.size()))
     counts_[static_cast<std::size_t>(status)].fetch_add(1, std::memory_order_relaxed);
@@ -120,16 +175,36 @@ std::vector<std::pair<int, std::uint64_t>> ResponseCounter::snapshot() const {
 }
 
 std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter& responses,
-                            int open_event_streams) {
+                            int open_event_streams, const HttpRequestMetrics* requests,
+                            const std::vector<HistogramSeries>& histograms) {
   std::string out;
+  append_build_info(out);
   if (backend.is_object()) {
     append_known(out, backend);
     append_jobs(out, backend);
     append_others(out, backend);
   }
-  header(out, "skyfarm_http_requests_total", "counter", "HTTP responses sent, by status code.");
-  for (const auto& [code, n] : responses.snapshot())
-    sample(out, "skyfarm_http_requests_total", "code=\"" + std::to_string(code) + "\"", std::to_string(n));
+  // The backend's histograms, a family per name in the order first named.
+  std::vector<std::string> names;
+  for (const HistogramSeries& h : histograms)
+    if (std::find(names.begin(), names.end(), h.name) == names.end()) names.push_back(h.name);
+  for (const std::string& name : names) {
+    std::vector<std::pair<std::string, MetricsHistogram::Snapshot>> series;
+    std::string help;
+    for (const HistogramSeries& h : histograms)
+      if (h.name == name) {
+        series.emplace_back(h.labels, h.snapshot);
+        help = h.help;
+      }
+    append_histogram(out, name, help, series);
+  }
+  if (requests) {
+    requests->append(out);
+  } else {
+    header(out, "skyfarm_http_requests_total", "counter", "HTTP responses sent, by status code.");
+    for (const auto& [code, n] : responses.snapshot())
+      sample(out, "skyfarm_http_requests_total", "code=\"" + std::to_string(code) + "\"", std::to_string(n));
+  }
   header(out, "skyfarm_http_event_streams", "gauge", "Open Server-Sent Events streams.");
   sample(out, "skyfarm_http_event_streams", "", std::to_string(open_event_streams));
   return out;

@@ -1,17 +1,24 @@
 // GET /metrics: the Prometheus text exposition format (version 0.0.4) of the
 // backend's numbers plus what the HTTP layer counts itself (responses by
-// status code, open event streams).  Every name is prefixed skyfarm_.
+// route, method and status code, their durations, open event streams) and
+// skyfarm_build_info.  Every name is prefixed skyfarm_.
 #pragma once
 #include <array>
 #include <atomic>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "common/core/metrics_histogram.h"
+#include "server/http/http_backend.h"
+
 namespace skyfarm::server {
+
+class HttpRequestMetrics;
 
 inline constexpr const char* kPrometheusContentType = "text/plain; version=0.0.4; charset=utf-8";
 
@@ -31,8 +38,26 @@ class ResponseCounter {
 // unit_failures -> skyfarm_unit_failures_total, jobs_<state> ->
 // skyfarm_jobs{state="<state>"}, ...); other numeric keys are exported as
 // gauges skyfarm_<key>; non-numeric values are skipped.
+// `requests`: when given, skyfarm_http_requests_total is labelled by route,
+// method and code from it (with the request durations) instead of by code
+// alone from `responses`.  `histograms`: the backend's (HttpBackend::histograms()).
 std::string prometheus_text(const nlohmann::json& backend, const ResponseCounter& responses,
-                            int open_event_streams);
+                            int open_event_streams, const HttpRequestMetrics* requests = nullptr,
+                            const std::vector<HistogramSeries>& histograms = {});
+
+// skyfarm_build_info{version,git_commit,compiler,build_type} 1 (build_info.h).
+void append_build_info(std::string& out);
+
+// The exposition's pieces, for the parts that append their own families.
+void append_metric_header(std::string& out, std::string_view name, std::string_view type, std::string_view help);
+void append_metric_sample(std::string& out, std::string_view name, std::string_view labels, const std::string& value);
+// A label value with backslash, double quote and newline escaped (the format's rule).
+std::string escaped_label_value(std::string_view value);
+// One histogram family: HELP, TYPE, then per series (labels without braces,
+// "" for none) its cumulative _bucket{...,le="..."} lines up to le="+Inf",
+// _sum and _count.  Only the header without series.
+void append_histogram(std::string& out, std::string_view name, std::string_view help,
+                      const std::vector<std::pair<std::string, MetricsHistogram::Snapshot>>& series);
 
 // The sky look-up caches (server/sky/sky_service.h), appended to `out`, labelled
 // cache="table" (built LUT skies) and cache="envmap" (encoded maps):

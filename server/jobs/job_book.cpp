@@ -71,6 +71,11 @@ void JobBook::set_state(Job& job, JobState state, const std::string& failure) {
   if (is_terminal(state) && !is_terminal(job.record.state)) {
     job.record.finished_unix = unix_now();
     store->set_finished(job.record.id, job.record.finished_unix);
+    // Submission to end, wall clock (a restart's downtime included).
+    const double seconds = std::max(0.0, job.record.finished_unix - job.record.created_unix);
+    if (state == JobState::kDone) job_seconds_done.observe(seconds);
+    else if (state == JobState::kFailed) job_seconds_failed.observe(seconds);
+    else if (state == JobState::kCancelled) job_seconds_cancelled.observe(seconds);
   }
   job.record.state = state;
   job.record.failure = failure;

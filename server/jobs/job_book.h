@@ -22,12 +22,14 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "common/core/metrics_histogram.h"
 #include "server/http/http_backend.h"
 #include "server/jobs/job.h"
 #include "server/jobs/job_state.h"
@@ -75,8 +77,18 @@ struct JobBook {
   std::uint64_t next_attempt = 1;
   std::vector<std::pair<std::string, std::uint64_t>> cancelled;  // (worker, attempt) to stop
   std::map<std::string, WorkerInfo> workers;
+  // Workers an operator drained (POST /v1/workers/{id}/drain): they get no
+  // new units until resumed, even after they reconnect under the same id.
+  std::set<std::string> drained_workers;
   std::int64_t next_sequence = 1;
   std::uint64_t unit_failures = 0, requeues = 0, results_refused = 0;
+  // /metrics: samples (paths) and units merged since start (counters), and
+  // durations: a unit from dispatch to merged, by method; a job from
+  // submission to its end, by final state (done, failed, cancelled).
+  std::uint64_t samples_total = 0, units_completed = 0;
+  MetricsHistogram unit_seconds_path{kUnitDurationBucketsS}, unit_seconds_lut{kUnitDurationBucketsS};
+  MetricsHistogram job_seconds_done{kJobDurationBucketsS}, job_seconds_failed{kJobDurationBucketsS},
+      job_seconds_cancelled{kJobDurationBucketsS};
   std::deque<std::pair<Clock::time_point, std::uint64_t>> recent_paths;  // for samples/s
   StateObserver state_observer;
   // Disk: the budget (0: none), the data directory's bytes outside the jobs'
@@ -108,6 +120,7 @@ struct JobBook {
   nlohmann::json status_of(const Job& job) const;
   // GET /metrics material (job_status.cpp).
   nlohmann::json metrics() const;
+  std::vector<HistogramSeries> histograms() const;
 
   // The job's dispatched units are to stop and its requeued ones are dropped.
   void drop_attempts_of(Job& job);

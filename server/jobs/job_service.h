@@ -69,7 +69,9 @@ class JobService final : public HttpBackend, public BrokerBackend {
   std::vector<JobEvent> events_after(const std::string& id, std::uint64_t after,
                                      std::chrono::milliseconds timeout) override;
   nlohmann::json workers() const override;
+  bool set_worker_draining(const std::string& worker_id, bool draining) override;
   nlohmann::json metrics() const override;
+  std::vector<HistogramSeries> histograms() const override;
 
   void worker_joined(const std::string& worker_id, const nlohmann::json& info) override;
   void worker_left(const std::string& worker_id) override;

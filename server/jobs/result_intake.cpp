@@ -52,7 +52,12 @@ void ResultIntake::unit_done(std::unique_lock<std::mutex>& lock, const std::stri
       if (w != workers.end()) ++w->second.units_done;
       ++job.worker_units[worker_id];
       job.paths += paths;
-      book_.recent_paths.emplace_back(Clock::now(), paths);
+      book_.samples_total += paths;
+      ++book_.units_completed;
+      const Clock::time_point merged_at = Clock::now();
+      (job.plan.lut ? book_.unit_seconds_lut : book_.unit_seconds_path)
+          .observe(std::chrono::duration<double>(merged_at - f.since).count());
+      book_.recent_paths.emplace_back(merged_at, paths);
       while (book_.recent_paths.size() > 10000) book_.recent_paths.pop_front();
     }
   } catch (const FilmTileDecodeError& e) {

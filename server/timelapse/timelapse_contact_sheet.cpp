@@ -92,8 +92,9 @@ void ContactSheet::add(int index, const Image& frame, double ev100, std::string_
 
 void ContactSheet::write(const std::filesystem::path& path) const {
   write_png_rgb8(path, canvas_.width(), canvas_.height(), canvas_.rgb(),
-                 {{"skyfarm:contact_sheet_frames", std::to_string(layout_.frames)},
-                  {"skyfarm:contact_sheet_columns", std::to_string(layout_.columns)}});
+                 {{std::string(kMetadataPrefix) + metadata_key::kContactSheetFrames, std::to_string(layout_.frames)},
+                  {std::string(kMetadataPrefix) + metadata_key::kContactSheetColumns,
+                   std::to_string(layout_.columns)}});
 }
 
 }  // namespace skyfarm::server

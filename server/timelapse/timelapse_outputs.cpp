@@ -98,8 +98,8 @@ OutputsReport build_timelapse_outputs(const std::vector<FrameInput>& frames, con
       return report;
     }
     Image image = load_frame(frames[i].exr);
-    image.set_metadata("timelapse_frame_index", static_cast<double>(i));
-    image.set_metadata("timelapse_frame_time", frames[i].label);
+    image.set_metadata(metadata_key::kTimelapseFrameIndex, static_cast<double>(i));
+    image.set_metadata(metadata_key::kTimelapseFrameTime, frames[i].label);
     PngWriteOptions png;
     png.exposure_ev = report.ev100[i];
     png.view = settings.view;

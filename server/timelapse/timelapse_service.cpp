@@ -49,6 +49,7 @@ TimelapseService::TimelapseService(JobService& jobs, fs::path data_dir, Timelaps
     try {
       // A record is re-read without the frame cap: it was accepted under the cap of its day.
       t->request = api::parse_timelapse_request(r.request.dump(), INT_MAX);
+      if (!r.name.empty()) t->request.base.name = r.name;  // not in the canonical request: its frames' names
     } catch (const std::exception& e) {
       problems.push_back(r.id + ": its request no longer reads: " + e.what());
       continue;
@@ -199,11 +200,28 @@ void TimelapseService::feed(Entry& t, int* active, int* done) {
   }
 }
 
+void TimelapseService::observe_end(const Entry& t) {
+  // Submission to end, wall clock, as the renders' (job_book.cpp).
+  const double seconds = std::max(0.0, t.record.finished_unix - t.record.created_unix);
+  if (t.record.state == JobState::kDone) durations_done_.observe(seconds);
+  else if (t.record.state == JobState::kFailed) durations_failed_.observe(seconds);
+  else if (t.record.state == JobState::kCancelled) durations_cancelled_.observe(seconds);
+}
+
+std::vector<HistogramSeries> TimelapseService::histograms() const {
+  constexpr const char* kName = "skyfarm_job_duration_seconds";
+  constexpr const char* kHelp = "Renders and timelapses from submission to their end, by kind and final state.";
+  return {{kName, kHelp, "kind=\"timelapse\",state=\"done\"", durations_done_.snapshot()},
+          {kName, kHelp, "kind=\"timelapse\",state=\"failed\"", durations_failed_.snapshot()},
+          {kName, kHelp, "kind=\"timelapse\",state=\"cancelled\"", durations_cancelled_.snapshot()}};
+}
+
 void TimelapseService::fail(Entry& t, const std::string& message) {
   cancel_frames(t);
   t.record.state = JobState::kFailed;
   t.record.failure = message;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
 }
 
@@ -266,6 +284,7 @@ void TimelapseService::build_outputs(const std::string& id) {
   t.record.video_reason = report.video_reason;
   t.record.state = JobState::kDone;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
 }
 
@@ -307,6 +326,7 @@ SubmitResult TimelapseService::submit(const api::TimelapseRequest& request, cons
   t->record.sequence = next_sequence_++;
   t->record.created_unix = unix_now();
   t->record.idempotency_key = key.value_or("");
+  t->record.name = request.base.name.value_or("");
   t->record.render_ids.assign(static_cast<std::size_t>(request.frame_count), "");
   save_record(root_, t->record);  // StorageError: 507, nothing kept
   const std::string id = t->record.id;
@@ -327,6 +347,7 @@ bool TimelapseService::cancel(const std::string& id) {
   cancel_frames(t);
   t.record.state = JobState::kCancelled;
   t.record.finished_unix = unix_now();
+  observe_end(t);
   persist(t);
   return true;
 }
@@ -385,6 +406,7 @@ nlohmann::json TimelapseService::status_of(const Entry& t) const {
   if (t.active()) stage = t.building || done == n ? "making_outputs" : "rendering";
   const auto& exposure = t.request.base.output.exposure_ev;
   return {{"id", t.record.id},
+          {"name", t.record.name.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.record.name)},
           {"state", to_string(state)},
           {"stage", stage},
           {"failure", t.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.record.failure)},

@@ -105,6 +105,10 @@ class TimelapseService {
   TimelapseFile contact_sheet(const std::string& id) const;
   TimelapseFile video(const std::string& id) const;
 
+  // /metrics: skyfarm_job_duration_seconds{kind="timelapse",state}, submission
+  // to end of the timelapses that ended since the server started.
+  std::vector<HistogramSeries> histograms() const;
+
   // Wakes the service's thread (a job changed state); also called by tests.
   void poke();
 
@@ -119,6 +123,8 @@ class TimelapseService {
   // Submits the next frames while fewer than frames_in_flight are active.
   void feed(Entry& t, int* active, int* done);
   void fail(Entry& t, const std::string& message);
+  // Counts a timelapse that just ended in skyfarm_job_duration_seconds.
+  void observe_end(const Entry& t);
   void cancel_frames(const Entry& t);
   void build_outputs(const std::string& id);
   void persist(const Entry& t) const;
@@ -135,6 +141,8 @@ class TimelapseService {
   std::vector<std::string> order_;  // creation order
   std::map<std::string, std::string> idempotency_;
   std::int64_t next_sequence_ = 1;
+  MetricsHistogram durations_done_{kJobDurationBucketsS}, durations_failed_{kJobDurationBucketsS},
+      durations_cancelled_{kJobDurationBucketsS};
 
   std::mutex wake_mu_;
   std::condition_variable wake_;

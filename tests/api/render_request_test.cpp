@@ -354,7 +354,7 @@ TEST(RenderRequestErrors, UnknownFieldsAreRejectedAtEveryLevel) {
   for (const auto& [body, message] : std::vector<std::pair<std::string, std::string>>{
            {with(R"("colour": 1)"),
             "colour: unknown field (allowed: location, time, sun, camera, atmosphere, spectral, quality, method, "
-            "output, seed, priority, objects, clouds)"},
+            "output, seed, priority, objects, clouds, name)"},
            {with(R"("quality": {"spp": 4})"),
             "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s, adaptive)"},
            {with(R"("output": {"png": true})"),

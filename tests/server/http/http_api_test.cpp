@@ -821,6 +821,8 @@ TEST_F(HttpApiTest, MetricsAreValidPrometheusText) {
     std::smatch m;
     if (std::regex_match(line, m, comment)) {
       if (m[1] == "TYPE") typed.insert(m[2]);
+      if (m[1] == "TYPE" && line.ends_with(" histogram"))  // its samples: _bucket, _sum, _count
+        for (const char* suffix : {"_bucket", "_sum", "_count"}) typed.insert(m[2].str() + suffix);
       continue;
     }
     ASSERT_TRUE(std::regex_match(line, m, sample)) << line;
@@ -831,7 +833,8 @@ TEST_F(HttpApiTest, MetricsAreValidPrometheusText) {
   EXPECT_GE(samples, 10);
   for (const char* expected : {"skyfarm_queue_units 12\n", "skyfarm_units_in_flight 3\n", "skyfarm_workers 2\n",
                                "skyfarm_samples_per_second 1500000\n", "skyfarm_unit_failures_total 1\n",
-                               "skyfarm_jobs{state=\"running\"} 2\n", "skyfarm_http_requests_total{code=\"404\"} 1\n",
+                               "skyfarm_jobs{state=\"running\"} 2\n",
+                               "skyfarm_http_requests_total{code=\"404\",method=\"GET\",route=\"/v1/renders/{id}\"} 1\n",
                                "# TYPE skyfarm_unit_failures_total counter\n", "skyfarm_results_refused_total 2\n",
                                "# TYPE skyfarm_results_refused_total counter\n", "skyfarm_disk_used_bytes 123456789\n",
                                "skyfarm_disk_budget_bytes 1000000000\n"})
@@ -903,7 +906,12 @@ TEST_F(HttpApiTest, StaysHealthyAfterManyBadRequests) {
   expect_healthy();
   auto metrics = c.Get("/metrics");
   ASSERT_TRUE(metrics);
-  EXPECT_NE(metrics->body.find("skyfarm_http_requests_total{code=\"400\"} 90"), std::string::npos) << metrics->body;
+  // 30 bad requests on each of three routes, labelled by template (never by the raw path).
+  for (const char* series : {"{code=\"400\",method=\"POST\",route=\"/v1/renders\"} 30\n",
+                             "{code=\"400\",method=\"GET\",route=\"/v1/renders/{id}\"} 30\n",
+                             "{code=\"400\",method=\"GET\",route=\"/v1/renders\"} 30\n"})
+    EXPECT_NE(metrics->body.find(std::string("skyfarm_http_requests_total") + series), std::string::npos)
+        << series << metrics->body;
 }
 
 // --- Pure checks ---------------------------------------------------------------------

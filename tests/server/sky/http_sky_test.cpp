@@ -221,6 +221,9 @@ TEST_F(SkyHttpTest, BadParametersAre400NamingTheParameter) {
   expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&color_space=acescg", "color_space");  // envmap only
   expect_bad("/v1/sky/envmap.exr?" + sun + "&altitude=200000&width=2048", "width");  // a ray march per pixel
   expect_bad("/v1/sky/envmap.exr?" + sun + "&view_zenith=0", "view_zenith");  // lookup only
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=cube", "layout");
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=equal_area&width=8192", "width");  // 4096 at most
+  expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&layout=equal_area", "layout");  // envmap only
   // Every error at once, each by its name.
   auto r = client().Get("/v1/sky?lat=95&view_azimuth=400&foo=1");
   ASSERT_TRUE(r);
@@ -335,6 +338,62 @@ TEST_F(SkyHttpTest, EnvmapPixelsAgreeWithLookupsAlongTheirDirections) {
         << x << "," << y;
   }
   EXPECT_EQ(service_->stats().table_builds, 1u) << "the map and the look-ups share the table";
+}
+
+TEST_F(SkyHttpTest, EqualAreaEnvmapIsSquareWithTheZenithAtTheCentre) {
+  start();
+  auto c = client();
+  // The default layout's canonical request has no `layout` key (older maps keep their bytes).
+  auto latlong = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none");
+  ASSERT_TRUE(latlong);
+  ASSERT_EQ(latlong->status, 200);
+  const auto latlong_request =
+      nlohmann::json::parse(read_exr_bytes(latlong->body).string_attributes.at("skyfarm:request"));
+  EXPECT_FALSE(latlong_request.contains("layout"));
+  auto same = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none&layout=latlong");
+  ASSERT_TRUE(same);
+  EXPECT_TRUE(same->body == latlong->body) << "layout=latlong is the default, byte for byte";
+
+  auto r = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&layout=equal_area");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const ExrFile exr = read_exr_bytes(r->body);
+  EXPECT_EQ(exr.width, 64);
+  EXPECT_EQ(exr.height, 64);
+  EXPECT_EQ(exr.string_attributes.at("skyfarm:layout").rfind("equal_area", 0), 0u);
+  EXPECT_EQ(nlohmann::json::parse(exr.string_attributes.at("skyfarm:request"))["layout"], "equal_area");
+  EXPECT_EQ(r->body.find("envmap"), std::string::npos) << "no LATLONG envmap attribute";
+  // The brightest pixel is the sun's: east of the zenith (right of the
+  // centre), on the centre row; zenith 60 deg -> r = sqrt(1 - cos 60) = 0.707
+  // of the half width: x = 32 + 0.707 x 32 = 54.6.
+  const auto& R = exr.channels.at("R").values;
+  const auto& G = exr.channels.at("G").values;
+  const auto& B = exr.channels.at("B").values;
+  std::size_t best = 0;
+  double best_y = -1;
+  for (std::size_t i = 0; i < R.size(); ++i) {
+    const double y = 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+    if (y > best_y) best_y = y, best = i;
+  }
+  EXPECT_NEAR(static_cast<int>(best % 64), 54, 1);
+  EXPECT_NEAR(static_cast<int>(best / 64), 32, 1);
+  // The four pixels around the centre surround the zenith, the four corners
+  // the nadir: their means are the look-ups there within 3 % (each pixel
+  // averages ~3 deg of a smooth sky; the ground near the nadir is uniform).
+  auto Y = [&](int x, int y) {
+    const std::size_t i = static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x);
+    return 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+  };
+  auto lookup = [&](const char* view) {
+    auto look = c.Get(std::string("/v1/sky?sun_zenith=60&sun_azimuth=90&") + view);
+    EXPECT_TRUE(look && look->status == 200);
+    return look ? json_of(look)["luminance_cd_m2"].get<double>() : 0.0;
+  };
+  const double zenith = lookup("view_zenith=0&view_azimuth=0");
+  const double nadir = lookup("view_zenith=180&view_azimuth=0");
+  EXPECT_NEAR((Y(31, 31) + Y(32, 31) + Y(31, 32) + Y(32, 32)) / 4, zenith, 0.03 * zenith);
+  for (auto [x, y] : {std::pair{0, 0}, std::pair{63, 0}, std::pair{0, 63}, std::pair{63, 63}})
+    EXPECT_NEAR(Y(x, y), nadir, 0.03 * nadir) << x << "," << y;
 }
 
 TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
