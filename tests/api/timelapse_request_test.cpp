@@ -106,6 +106,27 @@ TEST(TimelapseRequest, DefaultsAndOptions) {
   EXPECT_EQ(o.base.method, Method::kLut);
 }
 
+// output.view (and the EXR's colour space) reach every frame's request and
+// the timelapse's canonical text; a bad view names the field.
+TEST(TimelapseRequest, OutputViewAndColourSpaceReachTheFrames) {
+  const std::string range = R"("start": "2013-05-27T19:00:00Z", "end": "2013-05-27T19:10:00Z", "frames": 2)";
+  const TimelapseRequest plain = parse_timelapse_request(body(range));
+  const TimelapseRequest r =
+      parse_timelapse_request(body(range + R"(, "output": {"view": "aces", "color_space": "acescg"})"));
+  EXPECT_EQ(r.base.output.view, DisplayView::kAces);
+  EXPECT_EQ(r.frame_request(1).output.view, DisplayView::kAces);
+  EXPECT_EQ(r.frame_request(1).output.color_space, ColorSpace::kAcesCg);
+  EXPECT_NE(canonical_text(r), canonical_text(plain));
+  EXPECT_EQ(parse_timelapse_request(canonical_text(r)).base.output.view, DisplayView::kAces);
+  try {
+    parse_timelapse_request(body(range + R"(, "output": {"view": "filmic"})"));
+    ADD_FAILURE() << "accepted";
+  } catch (const ValidationError& e) {
+    ASSERT_EQ(e.errors().size(), 1u);
+    EXPECT_EQ(e.errors()[0].path, "output.view");
+  }
+}
+
 TEST(TimelapseRequest, ErrorsNameTheField) {
   const std::string range = R"("start": "2013-05-27T19:00:00Z", "end": "2013-05-27T20:00:00Z")";
   struct Case {

@@ -22,6 +22,8 @@
 #include <unistd.h>
 
 #include "api/render_spec.h"
+#include "common/image/exr_writer.h"
+#include "common/image/png_writer.h"
 #include "common/render/tile_renderer.h"
 #include "server/jobs/disk_budget.h"
 #include "server/jobs/job_ids.h"
@@ -485,6 +487,52 @@ TEST(JobService, LutJobIsOnePassApproximateAndMatchesTheLocalRender) {
   EXPECT_EQ(s["progress"]["samples_per_pixel"], 1);
   EXPECT_TRUE(s["error"]["estimated_relative_rms"].is_null()) << "a LUT render has no Monte Carlo estimate";
   EXPECT_EQ(read_file(service.image(id, ImageFormat::kExr)->path), local_render_exr(dir / "local", kLut));
+}
+
+// output.color_space / units / view: the server converts when it writes, as
+// `skyfarm-worker render` does (the same EXR bytes); the values are the
+// default job's, through OCIO's Rec.709 -> AP0 and divided by 683; the PNG
+// names its view.  The request hash differs (different files).
+TEST(JobService, ColourManagedOutputsMatchTheLocalRenderAndTheDefaultJob) {
+  constexpr const char* kPlain = R"({
+    "sun": {"zenith_deg": 85, "azimuth_deg": 140},
+    "camera": {"projection": "fisheye", "width": 32, "height": 32, "pitch_deg": 90, "fov_deg": 180},
+    "method": "lut",
+    "output": {"half": false}
+  })";
+  constexpr const char* kManaged = R"({
+    "sun": {"zenith_deg": 85, "azimuth_deg": 140},
+    "camera": {"projection": "fisheye", "width": 32, "height": 32, "pitch_deg": 90, "fov_deg": 180},
+    "method": "lut",
+    "output": {"half": false, "color_space": "aces2065-1", "units": "w_m2_sr", "view": "aces"}
+  })";
+  const fs::path dir = fresh_dir("colour");
+  JobService service(dir);
+  const auto plain = service.submit(api::parse_render_request(kPlain), std::nullopt).id;
+  const auto managed = service.submit(api::parse_render_request(kManaged), std::nullopt).id;
+  EXPECT_NE(plain, managed);
+  std::mt19937 rng(5);
+  run_shuffled(service, rng, 4);
+  ASSERT_EQ((*service.status(managed))["state"], "done");
+  const fs::path exr = service.image(managed, ImageFormat::kExr)->path;
+  EXPECT_EQ(read_file(exr), local_render_exr(dir / "local", kManaged));
+  const ExrFile a = read_exr(service.image(plain, ImageFormat::kExr)->path), b = read_exr(exr);
+  EXPECT_EQ(b.string_attributes.at("skyfarm:color_space"), "aces2065-1");
+  EXPECT_EQ(b.string_attributes.at("skyfarm:units"), "w_m2_sr");
+  ASSERT_TRUE(b.chromaticities.has_value());
+  EXPECT_NEAR((*b.chromaticities)[2].y, -0.077, 1e-7);
+  std::size_t lit = 0;
+  for (std::size_t i = 0; i < a.channels.at("R").values.size(); ++i) {
+    float v[3] = {a.channels.at("R").values[i], a.channels.at("G").values[i], a.channels.at("B").values[i]};
+    if (v[1] > 0) ++lit;
+    convert_color_space(ColorSpace::kLinRec709, ColorSpace::kAces2065_1, v, 1);
+    const char* names[3] = {"R", "G", "B"};
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(b.channels.at(names[c]).values[i], v[c] / 683.0, 1e-6 * std::abs(v[c]) / 683.0 + 1e-30) << i;
+  }
+  EXPECT_GT(lit, 0u);
+  EXPECT_EQ(read_png(service.image(managed, ImageFormat::kPng)->path).text.at("skyfarm:view"), "aces");
+  EXPECT_FALSE(read_png(service.image(plain, ImageFormat::kPng)->path).text.contains("skyfarm:view"));
 }
 
 // "quality.adaptive": pass 0 is a uniform pilot; no unit of a later pass is
