@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "api/cloud_fields.h"
+#include "api/job_name.h"
 #include "api/object_fields.h"
 
 namespace skyfarm::api {
@@ -15,6 +16,19 @@ constexpr std::int64_t kMaxPixels = std::int64_t{16384} * 8192;
 constexpr Choice<Projection> kProjections[] = {{"equirectangular", Projection::kEquirectangular},
                                                {"fisheye", Projection::kFisheye},
                                                {"perspective", Projection::kPerspective}};
+
+// The names of common/image/color_management.h, in its order (one list).
+constexpr Choice<ColorSpace> kColorSpaces[] = {{kColorSpaceNames[0].first, kColorSpaceNames[0].second},
+                                               {kColorSpaceNames[1].first, kColorSpaceNames[1].second},
+                                               {kColorSpaceNames[2].first, kColorSpaceNames[2].second},
+                                               {kColorSpaceNames[3].first, kColorSpaceNames[3].second}};
+constexpr Choice<RadiometricUnits> kUnits[] = {{kRadiometricUnitsNames[0].first, kRadiometricUnitsNames[0].second},
+                                               {kRadiometricUnitsNames[1].first, kRadiometricUnitsNames[1].second},
+                                               {kRadiometricUnitsNames[2].first, kRadiometricUnitsNames[2].second}};
+constexpr Choice<DisplayView> kViews[] = {{kDisplayViewNames[0].first, kDisplayViewNames[0].second},
+                                          {kDisplayViewNames[1].first, kDisplayViewNames[1].second}};
+static_assert(std::size(kColorSpaces) == kColorSpaceNames.size() && std::size(kUnits) == kRadiometricUnitsNames.size() &&
+              std::size(kViews) == kDisplayViewNames.size());
 
 // Per-projection defaults and field-of-view rule.
 struct ProjectionRules {
@@ -141,11 +155,27 @@ void read_output(const Fields& top, OutputSpec& o) {
   const Json* v = top.find("output");
   if (!v || !expect_object(*v, top.path_of("output"), top.errors())) return;
   Fields f(*v, top.path_of("output"), top.errors());
-  f.allow_only({"exposure_ev", "spectral_channels", "error_layer", "half"});
+  f.allow_only({"exposure_ev", "spectral_channels", "error_layer", "half", "color_space", "units", "view"});
   f.optional_number("exposure_ev", Range::closed(-50, 50), o.exposure_ev);
   f.boolean("spectral_channels", o.spectral_channels);
   f.boolean("error_layer", o.error_layer);
   f.boolean("half", o.half);
+  f.choice("color_space", kColorSpaces, o.color_space);
+  f.choice("units", kUnits, o.units);
+  f.choice("view", kViews, o.view);
+}
+
+// Written only when not the default, so that the requests of before keep
+// their canonical text (their hash, their cached results).
+Json output_json(const OutputSpec& o) {
+  Json j = {{"exposure_ev", optional_number_json(o.exposure_ev)},
+            {"spectral_channels", o.spectral_channels},
+            {"error_layer", o.error_layer},
+            {"half", o.half}};
+  if (o.color_space != ColorSpace::kLinRec709) j["color_space"] = std::string(name_of(kColorSpaces, o.color_space));
+  if (o.units != RadiometricUnits::kCdM2) j["units"] = std::string(name_of(kUnits, o.units));
+  if (o.view != DisplayView::kSrgb) j["view"] = std::string(name_of(kViews, o.view));
+  return j;
 }
 
 // --- The whole request.
@@ -153,7 +183,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   if (!body.is_object()) throw ValidationError({FieldError{"", "must be a JSON object", value_text(body)}});
   Fields top(body, "", e);
   top.allow_only({"location", "time", "sun", "camera", "atmosphere", "spectral", "quality", "method", "output",
-                  "seed", "priority", "objects", "clouds"});
+                  "seed", "priority", "objects", "clouds", "name"});
   RenderRequest r;
   read_location(top, r.location);
   read_time(top, r.time, r.time_text);
@@ -169,6 +199,7 @@ RenderRequest read_render_request(const Json& body, Errors& e) {
   read_output(top, r.output);
   read_seed(top, r.seed);
   top.integer("priority", 0, 100, r.priority);
+  read_job_name(top, r.name);
   if (r.method == Method::kLut && !r.objects.empty())
     e.add("objects", "the lut method renders the sky alone: objects need \"method\": \"path\"");
   // The LUT renderer ray-marches cloud layers; placed volumes need the path tracer.
@@ -233,11 +264,7 @@ nlohmann::json to_canonical_json(const RenderRequest& r) {
             {"batches", r.spectral.batches}}},
           {"quality", quality_json(r.quality)},
           {"method", std::string(name_of(kMethods, r.method))},
-          {"output",
-           {{"exposure_ev", optional_number_json(r.output.exposure_ev)},
-            {"spectral_channels", r.output.spectral_channels},
-            {"error_layer", r.output.error_layer},
-            {"half", r.output.half}}},
+          {"output", output_json(r.output)},
           {"seed", r.seed},
           {"priority", r.priority}};
   // Written only when there are objects: requests without keep their text.

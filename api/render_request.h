@@ -15,6 +15,7 @@
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/camera/camera_spec.h"
 #include "common/clouds/cloud_spec.h"
+#include "common/image/color_management.h"
 #include "common/objects/object_spec.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
@@ -56,6 +57,10 @@ struct OutputSpec {
   bool spectral_channels = false;     // one EXR channel per wavelength batch
   bool error_layer = false;           // relative standard error per pixel
   bool half = true;                   // EXR half floats (else 32-bit floats)
+  // Colour management at write time (common/image/color_management.h).
+  ColorSpace color_space = ColorSpace::kLinRec709;  // EXR RGB primaries
+  RadiometricUnits units = RadiometricUnits::kCdM2;  // EXR RGB units
+  DisplayView view = DisplayView::kSrgb;             // PNG view
 };
 
 // A validated render request, every default filled in.
@@ -74,6 +79,9 @@ struct RenderRequest {
   OutputSpec output;
   std::uint64_t seed = 1;
   int priority = 50;
+  // A label (api/job_name.h), never in the canonical request: it does not
+  // change what is rendered, so it changes neither the hash nor the EXR.
+  std::optional<std::string> name;
 };
 
 // Parses and validates a request body.  Throws ValidationError listing every
@@ -89,7 +97,8 @@ inline RenderRequest parse_render_request(const char* json_text) {
 
 // Every field with its default filled in and equivalent spellings unified
 // (docs/request-schema.md "Canonical form"): requests that mean the same give
-// the same to_canonical_json(r).dump(); parsing it gives the same request back.
+// the same to_canonical_json(r).dump(); parsing it gives the same request back
+// (but for "name", which is left out: it labels a render, it is not rendered).
 nlohmann::json to_canonical_json(const RenderRequest& request);
 // to_canonical_json(request).dump(): the text the farm hashes.
 std::string canonical_text(const RenderRequest& request);

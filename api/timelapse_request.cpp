@@ -8,7 +8,8 @@ namespace {
 
 // The render request's top-level fields a timelapse shares ("time" excluded).
 constexpr std::string_view kRenderFields[] = {"location", "sun",    "camera", "atmosphere", "spectral", "quality",
-                                              "method",   "output", "seed",   "priority", "clouds"};
+                                              "method",   "output", "seed",   "priority", "clouds",
+                                              "name"};
 // Used in place of "time" while the shared fields are validated (the render
 // parser needs a time or sun angles); any valid instant will do.
 constexpr const char* kPlaceholderTime = "2000-01-01T00:00:00Z";
@@ -163,7 +164,7 @@ TimelapseRequest read_timelapse_request(const Json& body, int max_frames, Errors
     Json others = body;
     others.erase("time");
     Fields(others, "", e).allow_only({"location", "sun", "camera", "atmosphere", "spectral", "quality", "method",
-                                      "output", "seed", "priority", "clouds", "start", "end", "step_s", "frames",
+                                      "output", "seed", "priority", "clouds", "name", "start", "end", "step_s", "frames",
                                       "same_seed", "exposure_smoothing_frames", "video_fps"});
   }
   Fields top(body, "", e);
@@ -204,6 +205,8 @@ RenderRequest TimelapseRequest::frame_request(int i) const {
   r.time = frame_time(i);
   r.time_text = frame_time_text(i);
   if (!same_seed) r.seed = base.seed + static_cast<std::uint64_t>(i);
+  // Each frame is listed among the renders under its timelapse's name.
+  if (base.name) r.name = *base.name + " (frame " + std::to_string(i + 1) + " of " + std::to_string(frame_count) + ")";
   return r;
 }
 

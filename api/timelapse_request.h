@@ -19,6 +19,9 @@
 //                       stay centred), so the video does not pump; a number in
 //                       output.exposure_ev fixes every frame's EV100 instead
 //   video_fps           integer in [1, 120], default 24
+//   name                a label, as in render requests (api/job_name.h); left
+//                       out of the canonical form; each frame's render is
+//                       named "<name> (frame i of n)"
 // At most `max_frames` frames (default kMaxTimelapseFrames); more is a 400
 // naming "frames" or "step_s".  Frame times are computed in whole
 // milliseconds.  "time", "sun.zenith_deg" and "sun.azimuth_deg" are refused:

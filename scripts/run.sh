@@ -2,9 +2,11 @@
 # One command for a fresh Debian machine: installs what is missing, builds in
 # Release and runs the service: skyfarm-server on http://127.0.0.1:8080 with
 # one local worker per core.  It then renders the demo skies THROUGH THE HTTP
-# API with curl (a sunset equirect over Ithaca, a noon all-sky fisheye over
-# Paris) into ./skyfarm-demo, and keeps serving until Ctrl-C.
-#   SKYFARM_LISTEN, SKYFARM_DATA_DIR, ... (see skyfarm-server --help) apply.
+# API with the Python client (clients/python, `python3 -m skyfarm render`: a
+# sunset equirect over Ithaca, a noon all-sky fisheye over Paris) into
+# ./skyfarm-demo, and keeps serving until Ctrl-C.
+#   SKYFARM_LISTEN, SKYFARM_DATA_DIR, SKYFARM_TOKEN, ... (see skyfarm-server
+#   --help) apply; the client reads SKYFARM_TOKEN too.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 "$root/scripts/install-deps.sh"
@@ -24,24 +26,12 @@ for _ in $(seq 100); do
   sleep 0.1
 done
 
+skyfarm() { PYTHONPATH="$root/clients/python${PYTHONPATH:+:$PYTHONPATH}" python3 -m skyfarm --server "http://$listen" "$@"; }
 for request in "$root"/api/examples/demo_*.json; do
   name=$(basename "$request" .json)
   name=${name#demo_}
-  id=$(curl -sf -X POST -H 'Content-Type: application/json' --data-binary @"$request" \
-       "http://$listen/v1/renders" | sed -n 's/.*"id":"\([^"]*\)".*/\1/p')
-  echo "$name: job $id (http://$listen/v1/renders/$id)"
-  while :; do
-    status=$(curl -sf "http://$listen/v1/renders/$id")
-    state=$(echo "$status" | sed -n 's/.*"state":"\([a-z]*\)".*/\1/p')
-    fraction=$(echo "$status" | sed -n 's/.*"fraction":\([0-9.e-]*\).*/\1/p')
-    printf '\r  %-8s %5.1f%%' "$state" "$(echo "${fraction:-0} * 100" | bc -l 2>/dev/null || echo 0)"
-    case $state in done) break ;; failed|cancelled) echo; echo "$status" >&2; exit 1 ;; esac
-    sleep 0.5
-  done
-  echo
-  curl -sf -o "$out/$name.exr" "http://$listen/v1/renders/$id/image.exr"
-  curl -sf -o "$out/$name.png" "http://$listen/v1/renders/$id/image.png"
-  echo "  wrote $out/$name.exr and $out/$name.png"
+  echo "$name:"
+  skyfarm render "$request" -o "$out/$name.exr" --png "$out/$name.png"
 done
 
 echo "skyfarm is serving on http://$listen: the web page at http://$listen/, the API under /v1"

@@ -117,6 +117,9 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
   exr.spectral_channels = request.output.spectral_channels;
   exr.error_layer = request.output.error_layer;
   exr.latlong_envmap = request.camera.projection == Projection::kEquirectangular;
+  exr.color_space = request.output.color_space;
+  exr.units = request.output.units;
+  exr.exposure_ev = request.output.exposure_ev;
   const ExrWriteReport exr_report = write_exr(image, exr_path, exr);
   std::printf("wrote %s\n", exr_path.c_str());
   if (exr_report.clamped_half_values > 0)
@@ -127,6 +130,7 @@ int render_to_files(const api::RenderRequest& request, const std::string& exr_pa
     PngWriteOptions png;
     png.exposure_ev = request.output.exposure_ev;
     png.bit_depth = png_bits;
+    png.view = request.output.view;
     const PngWriteReport r = write_png(image, png_path, png);
     std::printf("wrote %s (exposure EV100 %.2f)\n", png_path.c_str(), r.exposure_ev);
   }

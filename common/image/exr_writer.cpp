@@ -22,6 +22,8 @@
 #include <stdexcept>
 #include <system_error>
 
+#include "common/image/png_writer.h"
+
 namespace skyfarm {
 
 namespace {
@@ -106,18 +108,37 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
   const Imf::PixelType rgb_type = options.half ? Imf::HALF : Imf::FLOAT;
   ExrWriteReport report;
 
+  // Another colour space or other units: a converted copy of the RGB.  The
+  // defaults write the image's buffer as it is (the bytes of before).
+  const bool converted = options.color_space != ColorSpace::kLinRec709 || options.units != RadiometricUnits::kCdM2;
+  double units_factor = 1.0;
+  std::vector<float> converted_rgb;
+  if (converted) {
+    double relative = 1.0;
+    if (options.units == RadiometricUnits::kRelative) {
+      if (options.exposure_ev && !std::isfinite(*options.exposure_ev))
+        throw std::invalid_argument("write_exr: exposure_ev must be finite");
+      relative = exposure_scale(options.exposure_ev ? *options.exposure_ev : auto_exposure_ev(image));
+    }
+    units_factor = units_scale(options.units, relative);
+    converted_rgb = image.rgb();
+    convert_color_space(ColorSpace::kLinRec709, options.color_space, converted_rgb.data(), converted_rgb.size() / 3);
+    if (units_factor != 1.0)
+      for (float& v : converted_rgb) v = static_cast<float>(units_factor * static_cast<double>(v));
+  }
+  const std::vector<float>& rgb = converted ? converted_rgb : image.rgb();
+
   // HALF: count the values that will be clamped (the count goes into the header).
   if (options.half) {
-    for (float v : image.rgb()) (void)clamp_half(v, &report.clamped_half_values);
+    for (float v : rgb) (void)clamp_half(v, &report.clamped_half_values);
   }
 
   Imf::Header header(w, h);
   header.compression() = to_imf(options.compression);
-  Imf::addChromaticities(header, Imf::Chromaticities(Imath::V2f(float(kRec709Red.x), float(kRec709Red.y)),
-                                                     Imath::V2f(float(kRec709Green.x), float(kRec709Green.y)),
-                                                     Imath::V2f(float(kRec709Blue.x), float(kRec709Blue.y)),
-                                                     Imath::V2f(float(kD65White.x), float(kD65White.y))));
-  Imf::addWhiteLuminance(header, 1.0f);
+  const std::array<Chromaticity, 4> prim = chromaticities_of(options.color_space);
+  auto v2f = [](Chromaticity c) { return Imath::V2f(float(c.x), float(c.y)); };
+  Imf::addChromaticities(header, Imf::Chromaticities(v2f(prim[0]), v2f(prim[1]), v2f(prim[2]), v2f(prim[3])));
+  Imf::addWhiteLuminance(header, static_cast<float>(1.0 / units_factor));
   if (options.latlong_envmap) Imf::addEnvmap(header, Imf::ENVMAP_LATLONG);
   for (const auto& [key, value] : image.metadata()) {
     const std::string name = kExrMetadataPrefix + key;
@@ -125,6 +146,13 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
       header.insert(name, Imf::StringAttribute(*s));
     else
       header.insert(name, Imf::DoubleAttribute(std::get<double>(value)));
+  }
+  if (options.color_space != ColorSpace::kLinRec709)
+    header.insert(std::string(kExrMetadataPrefix) + "color_space",
+                  Imf::StringAttribute(std::string(name_of(options.color_space))));
+  if (options.units != RadiometricUnits::kCdM2) {
+    header.insert(std::string(kExrMetadataPrefix) + "units", Imf::StringAttribute(std::string(name_of(options.units))));
+    header.insert(std::string(kExrMetadataPrefix) + "units_scale", Imf::DoubleAttribute(units_factor));
   }
   if (options.half)
     header.insert(std::string(kExrMetadataPrefix) + metadata_key::kHalfClampedValues,
@@ -163,7 +191,7 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
       const int rows = std::min(kRowsPerBlock, h - y0);
       Imf::FrameBuffer fb;
       if (options.half) {
-        const float* src = image.rgb().data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(w) * 3;
+        const float* src = rgb.data() + static_cast<std::size_t>(y0) * static_cast<std::size_t>(w) * 3;
         const std::size_t n = static_cast<std::size_t>(rows) * static_cast<std::size_t>(w) * 3;
         std::size_t ignored = 0;
         for (std::size_t i = 0; i < n; ++i) staging[i] = half(clamp_half(src[i], &ignored));
@@ -174,7 +202,7 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
       } else {
         const char* names[3] = {"R", "G", "B"};
         for (int c = 0; c < 3; ++c)
-          fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, image.rgb().data() + c, origin, w, h, 3 * sizeof(float),
+          fb.insert(names[c], Imf::Slice::Make(Imf::FLOAT, rgb.data() + c, origin, w, h, 3 * sizeof(float),
                                                3 * sizeof(float) * static_cast<std::size_t>(w)));
       }
       for (int b = 0; b < static_cast<int>(spectral_names.size()); ++b)

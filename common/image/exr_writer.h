@@ -14,11 +14,20 @@
 //   latlong_envmap     set the standard `envmap` attribute to LATLONG; only
 //                      for an equirectangular image laid out as OpenEXR's
 //                      lat-long convention expects (the caller knows)
+//   color_space        ColorSpace of R, G, B (color_management.h): lin_rec709
+//                      (default: the image's RGB as it is), acescg,
+//                      aces2065-1, cie_xyz; converted at write time
+//   units              RadiometricUnits of R, G, B: cd_m2 (default), relative
+//                      (times the PNG's exposure scale 0.18 · 2^(3 − EV100)),
+//                      w_m2_sr (cd/m² / 683); spectral channels keep theirs
+//   exposure_ev        EV100 of the relative units; std::nullopt (default) =
+//                      automatic, as the PNG's (auto_exposure_ev, median)
 //
 // The file (scan lines, top row first, data window = display window =
 // [0, width − 1] × [0, height − 1]):
 //   channels
-//     R, G, B            linear Rec.709 in cd/m² (HALF or FLOAT)
+//     R, G, B            linear Rec.709 in cd/m² (HALF or FLOAT); or the
+//                        color_space and units asked for
 //     S0.<λ>nm           one per spectral band, FLOAT: the band's mean
 //                        spectral radiance, W m⁻² sr⁻¹ nm⁻¹, named by the band
 //                        centre λ with six decimals and ',' as the decimal
@@ -26,9 +35,14 @@
 //     error.Y            FLOAT: relative standard error of the luminance,
 //                        sqrt(Var[Y]) / Y (dimensionless); +inf = unknown
 //   attributes
-//     chromaticities     Rec.709 primaries, D65 white (0.3127, 0.3290)
+//     chromaticities     Rec.709 primaries, D65 white (0.3127, 0.3290); or
+//                        those of the color_space (chromaticities_of)
 //     whiteLuminance     1.0: RGB (1, 1, 1) is 1 cd/m² (OpenEXR's meaning:
-//                        "the luminance, in nits, of the RGB value (1, 1, 1)")
+//                        "the luminance, in nits, of the RGB value (1, 1, 1)");
+//                        1 / units_scale in other units
+//     skyfarm:color_space  (string, only when not lin_rec709)
+//     skyfarm:units, skyfarm:units_scale  (string; double, the factor that
+//                        turned cd/m² into the values: only when not cd_m2)
 //     spectralLayoutVersion = "1.0", emissiveUnits = "W.m^-2.sr^-1"
 //                        (only with spectral channels; see below)
 //     skyfarm:<key>      each Image metadata entry: a string as a string
@@ -62,6 +76,7 @@
 
 #include "common/film/image.h"
 #include "common/image/atomic_file.h"
+#include "common/image/color_management.h"
 
 namespace skyfarm {
 
@@ -73,6 +88,9 @@ struct ExrWriteOptions {
   bool error_layer = true;
   ExrCompression compression = ExrCompression::kZip;
   bool latlong_envmap = false;
+  ColorSpace color_space = ColorSpace::kLinRec709;
+  RadiometricUnits units = RadiometricUnits::kCdM2;
+  std::optional<double> exposure_ev = std::nullopt;
 };
 
 struct ExrWriteReport {

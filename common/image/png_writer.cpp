@@ -189,10 +189,28 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   const double max_code = options.bit_depth == 16 ? 65535.0 : 255.0;
   std::vector<png_byte> pixels(row_bytes * static_cast<std::size_t>(h));
   const std::vector<float>& rgb = image.rgb();
+  // The ACES view: exposed scene light through OCIO's output transform, to
+  // encoded display values (color_management.h); srgb: clip, then encode.
+  std::vector<float> display;
+  if (options.view == DisplayView::kAces) {
+    display.resize(rgb.size());
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+      const double v = report.scale * static_cast<double>(rgb[i]);
+      display[i] = std::isfinite(v) ? static_cast<float>(v) : (v > 0 ? 65504.0f : 0.0f);
+    }
+    apply_aces_srgb_view(display.data(), display.size() / 3);
+  }
   for (std::size_t i = 0; i < rgb.size(); ++i) {
-    double v = report.scale * static_cast<double>(rgb[i]);
-    v = std::isnan(v) ? 0.0 : std::clamp(v, 0.0, 1.0);
-    const auto code = static_cast<std::uint32_t>(std::lround(srgb_encode(v) * max_code));
+    double encoded;
+    if (options.view == DisplayView::kAces) {
+      const double v = static_cast<double>(display[i]);
+      encoded = std::isnan(v) ? 0.0 : std::clamp(v, 0.0, 1.0);
+    } else {
+      double v = report.scale * static_cast<double>(rgb[i]);
+      v = std::isnan(v) ? 0.0 : std::clamp(v, 0.0, 1.0);
+      encoded = srgb_encode(v);
+    }
+    const auto code = static_cast<std::uint32_t>(std::lround(encoded * max_code));
     if (bytes_per_sample == 1) {
       pixels[i] = static_cast<png_byte>(code);
     } else {  // PNG stores 16-bit samples big-endian
@@ -210,6 +228,8 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   }
   entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureEv100, shortest(report.exposure_ev));
   entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureScale, shortest(report.scale));
+  // Only a non-default view is named: the default's bytes stay as they were.
+  if (options.view != DisplayView::kSrgb) entries.emplace_back("skyfarm:view", std::string(name_of(options.view)));
   write_png_rows(path, w, h, options.bit_depth, rows.data(), entries);
   return report;
 }

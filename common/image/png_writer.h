@@ -8,6 +8,9 @@
 //   auto_percentile  which luminance percentile the automatic exposure meters,
 //                    in (0, 1); default 0.5 (the median)
 //   bit_depth        8 (default) or 16 bits per channel
+//   view             DisplayView (color_management.h): srgb (default; the
+//                    clip below) or aces (ACES 1.0 SDR output transform after
+//                    the exposure, instead of the clip and the sRGB curve)
 //
 // Exposure convention (a reflected-light meter, ISO 2720:1974, calibration
 // constant K = 12.5 cd/m²).  A camera at ISO S meters a luminance L as
@@ -35,6 +38,7 @@
 //   skyfarm:<key>            each Image metadata entry (numbers in shortest
 //                            round-trip decimal)
 //   skyfarm:exposure_ev100   the EV100 used;  skyfarm:exposure_scale  the scale
+//   skyfarm:view             the view, when not srgb
 // Keys are restricted to PNG's keyword rules (1–79 Latin-1 characters):
 // other characters become '_', longer keys are cut.
 //
@@ -50,6 +54,7 @@
 
 #include "common/film/image.h"
 #include "common/image/atomic_file.h"
+#include "common/image/color_management.h"
 
 namespace skyfarm {
 
@@ -57,6 +62,7 @@ struct PngWriteOptions {
   std::optional<double> exposure_ev;
   double auto_percentile = 0.5;
   int bit_depth = 8;
+  DisplayView view = DisplayView::kSrgb;
 };
 
 struct PngWriteReport {

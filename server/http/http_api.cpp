@@ -6,12 +6,16 @@
 #include <chrono>
 #include <optional>
 #include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <thread>
 
 #include "api/json_fields.h"
 #include "api/render_request.h"
 #include "api/render_spec.h"
+#include "common/image/png_thumbnail.h"
 #include "server/http/http_checks.h"
 #include "server/http/http_files.h"
 #include "server/http/http_gate.h"
@@ -333,6 +337,12 @@ void HttpApi::add_routes(httplib::Server& server) {
   routes.get("/v1/renders/{id}/image.png", guarded(&HttpApi::image_png));
   routes.get("/v1/renders/{id}/events", guarded(&HttpApi::events));
   routes.get("/v1/workers", guarded(&HttpApi::workers));
+  for (const bool drain : {true, false})
+    routes.post(drain ? "/v1/workers/{id}/drain" : "/v1/workers/{id}/resume",
+                [this, drain](const Request& req, Response& res, const ContentReader&) {
+                  close_if_body_unread(req, res);  // the route takes no body
+                  run_guarded(req, res, [&] { drain_worker(req, res, drain); });
+                });
   routes.get("/v1/sky", guarded(&HttpApi::sky));
   routes.post("/v1/sky/radiance", [this](const Request& req, Response& res, const ContentReader& reader) {
     run_guarded(req, res, [&] { sky_radiance(req, res, reader); });
@@ -448,10 +458,65 @@ void HttpApi::cancel(const Request& req, Response& res) {
 }
 
 void HttpApi::image_exr(const Request& req, Response& res) { image(req, res, ImageFormat::kExr); }
-void HttpApi::image_png(const Request& req, Response& res) { image(req, res, ImageFormat::kPng); }
+void HttpApi::image_png(const Request& req, Response& res) {
+  if (req.has_param("width")) thumbnail(req, res);
+  else image(req, res, ImageFormat::kPng);
+}
+
+// GET .../image.png?width=N: the PNG scaled down to N pixels wide (aspect
+// kept; common/image/png_thumbnail.h), for lists.  A final image's thumbnail
+// is written once beside it (image-wN.png, removed with the job's files) and
+// served with the image's ETag and a "-wN" suffix; a preview's is made for
+// each request and not kept (the preview changes as units merge).
+void HttpApi::thumbnail(const Request& req, Response& res) {
+  constexpr int kMaxThumbnailWidth = 1024;
+  const std::string text = req.get_param_value("width");
+  const auto width = parse_decimal(text, kMaxThumbnailWidth);
+  if (req.get_param_value_count("width") > 1 || !width || *width < 1)
+    throw invalid_parameter("width", "must be an integer in [1, 1024], given once", quote_text(text));
+  const std::string id = job_id_of(req);
+  const ImageFile file = image_file(id, ImageFormat::kPng);
+  const std::string suffix = "-w" + std::to_string(*width);
+  std::string etag = file.etag;
+  etag.insert(etag.empty() ? 0 : etag.size() - 1, suffix);  // inside the quotes
+  const std::lock_guard<std::mutex> lock(thumbnail_writer_);  // one writer of a thumbnail file at a time
+  try {
+    if (file.final) {
+      const std::filesystem::path thumb = file.path.parent_path() / ("image" + suffix + ".png");
+      if (!std::filesystem::exists(thumb)) write_png_thumbnail(file.path, thumb, static_cast<int>(*width));
+      send_file(req, res, ImageFile{thumb, etag, true},
+                {"image/png", id + suffix + ".png", final_cache_control(options_.token.has_value()),
+                 "the thumbnail of render \"" + id + "\" could not be read"});
+      return;
+    }
+    const std::filesystem::path thumb = file.path.parent_path() / "preview-thumbnail.png";
+    write_png_thumbnail(file.path, thumb, static_cast<int>(*width));
+    std::ifstream in(thumb, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::error_code ec;
+    std::filesystem::remove(thumb, ec);
+    res.status = 200;
+    res.set_header("ETag", etag);
+    res.set_header("Cache-Control", "no-cache");
+    res.set_content(std::move(bytes), "image/png");
+  } catch (const HttpError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw http_error(500, "the thumbnail of render \"" + id + "\" could not be made: " + std::string(e.what()));
+  }
+}
 
 void HttpApi::image(const Request& req, Response& res, ImageFormat format) {
   const std::string id = job_id_of(req);
+  const ImageFile file = image_file(id, format);
+  const bool exr = format == ImageFormat::kExr;
+  send_file(req, res, file,
+            {exr ? "image/x-exr" : "image/png", id + (exr ? ".exr" : ".png"), final_cache_control(options_.token.has_value()),
+             "the image file of render \"" + id + "\" could not be read"});
+}
+
+// The image file of a render, or the problem that says why there is none.
+ImageFile HttpApi::image_file(const std::string& id, ImageFormat format) {
   const std::optional<ImageFile> file = backend_.image(id, format);
   if (!file) {
     const std::optional<nlohmann::json> doc = backend_.status(id);
@@ -470,10 +535,7 @@ void HttpApi::image(const Request& req, Response& res, ImageFormat format) {
                ") has no image: its first pass has not covered the whole frame yet";
     throw HttpError(std::move(p));
   }
-  const bool exr = format == ImageFormat::kExr;
-  send_file(req, res, *file,
-            {exr ? "image/x-exr" : "image/png", id + (exr ? ".exr" : ".png"), final_cache_control(options_.token.has_value()),
-             "the image file of render \"" + id + "\" could not be read"});
+  return *file;
 }
 
 void HttpApi::events(const Request& req, Response& res) {
@@ -501,6 +563,20 @@ void HttpApi::events(const Request& req, Response& res) {
 }
 
 void HttpApi::workers(const Request&, Response& res) { send_json(res, 200, {{"workers", backend_.workers()}}); }
+
+// POST /v1/workers/{id}/drain | resume: 200 with the worker's entry of GET
+// /v1/workers ("draining" as set); 404 for a worker not connected.
+void HttpApi::drain_worker(const Request& req, Response& res, bool drain) {
+  const std::string id = req.matches.size() > 1 ? req.matches[1].str() : std::string();
+  if (!backend_.set_worker_draining(id, drain))
+    throw http_error(404, "there is no connected worker with id " + quote_text(id) + " (GET /v1/workers lists them)");
+  for (const nlohmann::json& w : backend_.workers())
+    if (w.value("id", "") == id) {
+      send_json(res, 200, w);
+      return;
+    }
+  throw http_error(404, "worker " + quote_text(id) + " left");
+}
 
 void HttpApi::sky(const Request& req, Response& res) { sky_->lookup(req, res); }
 

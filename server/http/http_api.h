@@ -56,6 +56,7 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -149,6 +150,9 @@ class HttpApi {
   void image_png(const httplib::Request& req, httplib::Response& res);
   void events(const httplib::Request& req, httplib::Response& res);
   void workers(const httplib::Request& req, httplib::Response& res);
+  void drain_worker(const httplib::Request& req, httplib::Response& res, bool drain);
+  void thumbnail(const httplib::Request& req, httplib::Response& res);
+  ImageFile image_file(const std::string& id, ImageFormat format);
   void sky(const httplib::Request& req, httplib::Response& res);
   void sky_radiance(const httplib::Request& req, httplib::Response& res, const httplib::ContentReader& reader);
   void sky_envmap(const httplib::Request& req, httplib::Response& res);
@@ -180,6 +184,7 @@ class HttpApi {
   std::unique_ptr<AssetHttp> assets_;
   const GatedHttpServer* gate_ = nullptr;  // its metrics, when the server is one
   std::vector<Route> routes_;
+  std::mutex thumbnail_writer_;  // thumbnail files (AtomicFile: one writer of a path at a time)
 };
 
 }  // namespace skyfarm::server

@@ -78,8 +78,12 @@ class HttpBackend {
   // Events with sequence > after; waits up to `timeout` for one; empty on timeout.
   virtual std::vector<JobEvent> events_after(const std::string& id, std::uint64_t after,
                                              std::chrono::milliseconds timeout) = 0;
-  // GET /v1/workers: [{"id", "cores", "version", "units_done", "units_in_flight", "last_seen_s"}].
+  // GET /v1/workers: [{"id", "cores", "version", "units_done", "units_in_flight", "draining", "last_seen_s"}].
   virtual nlohmann::json workers() const = 0;
+  // POST /v1/workers/{id}/drain and .../resume: a drained worker gets no new
+  // units (those in flight finish) until resumed.  false: no such worker
+  // connected (404); backends without workers have none.
+  virtual bool set_worker_draining(const std::string& /*worker_id*/, bool /*draining*/) { return false; }
   // /metrics material: {"queue_units", "units_in_flight", "jobs_queued", "jobs_running", "jobs_done",
   // "jobs_failed", "workers", "samples_per_second", "unit_failures", "requeues", "results_refused", "disk_used_bytes",
   // "disk_budget_bytes" (0: no limit)} (numbers).

@@ -43,7 +43,8 @@ SubmitResult Admission::submit(const api::RenderRequest& request, const std::opt
       return {job.record.id, false, false};
     }
   }
-  // Result cache: an identical request that is done, or still on its way.
+  // Result cache: an identical request that is done, or still on its way
+  // (its name aside: the job answered keeps the name it was given).
   for (const auto& id : book_.order) {
     const Job& job = *book_.jobs.at(id);
     if (job.record.request_hash == hash && ((job.record.state == JobState::kDone && !job.expired) || job.active() || job.finishing)) {
@@ -94,6 +95,7 @@ SubmitResult Admission::submit(const api::RenderRequest& request, const std::opt
   r.created_unix = unix_now();
   r.idempotency_key = key.value_or("");
   r.sequence = book_.next_sequence++;
+  r.name = request.name.value_or("");
   book_.store->insert(r);
   Job& job = book_.add_job(std::move(r), request);
   book_.emit(job, "queued");

@@ -22,6 +22,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -76,6 +77,9 @@ struct JobBook {
   std::uint64_t next_attempt = 1;
   std::vector<std::pair<std::string, std::uint64_t>> cancelled;  // (worker, attempt) to stop
   std::map<std::string, WorkerInfo> workers;
+  // Workers an operator drained (POST /v1/workers/{id}/drain): they get no
+  // new units until resumed, even after they reconnect under the same id.
+  std::set<std::string> drained_workers;
   std::int64_t next_sequence = 1;
   std::uint64_t unit_failures = 0, requeues = 0, results_refused = 0;
   // /metrics: samples (paths) and units merged since start (counters), and

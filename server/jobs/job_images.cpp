@@ -41,7 +41,11 @@ ImageSnapshot snapshot_images(Job& job, bool final) {
   snap.exr.spectral_channels = out.spectral_channels;
   snap.exr.error_layer = out.error_layer;
   snap.exr.latlong_envmap = job.request.camera.projection == Projection::kEquirectangular;
+  snap.exr.color_space = out.color_space;
+  snap.exr.units = out.units;
+  snap.exr.exposure_ev = out.exposure_ev;
   snap.png.exposure_ev = out.exposure_ev;
+  snap.png.view = out.view;
   return snap;
 }
 

@@ -189,6 +189,11 @@ nlohmann::json JobService::workers() const {
   return parts_->scheduler.workers();
 }
 
+bool JobService::set_worker_draining(const std::string& worker_id, bool draining) {
+  const std::lock_guard<std::mutex> lock(parts_->book.mu);
+  return parts_->scheduler.set_draining(worker_id, draining);
+}
+
 nlohmann::json JobService::metrics() const {
   const std::lock_guard<std::mutex> lock(parts_->book.mu);
   return parts_->book.metrics();

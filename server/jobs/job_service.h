@@ -69,6 +69,7 @@ class JobService final : public HttpBackend, public BrokerBackend {
   std::vector<JobEvent> events_after(const std::string& id, std::uint64_t after,
                                      std::chrono::milliseconds timeout) override;
   nlohmann::json workers() const override;
+  bool set_worker_draining(const std::string& worker_id, bool draining) override;
   nlohmann::json metrics() const override;
   std::vector<HistogramSeries> histograms() const override;
 

@@ -30,7 +30,12 @@ nlohmann::json JobBook::status_of(const Job& job) const {
     estimate_rgb = job.history.back().value("estimated_relative_rms_rgb", nlohmann::json(nullptr));
     unknown = job.history.back()["pixels_without_estimate"];
   }
+  // What it asked for, as the console shows it (and Duplicate re-submits):
+  // the canonical request; the name beside it, as the name is not part of it.
+  nlohmann::json request = nlohmann::json::parse(job.record.request, nullptr, false);
+  if (request.is_discarded()) request = nullptr;
   return {{"id", job.record.id},
+          {"name", job.record.name.empty() ? nlohmann::json(nullptr) : nlohmann::json(job.record.name)},
           {"state", to_string(job.record.state)},
           {"method", job.plan.lut ? "lut" : "path"},
           // The LUT renderer's error is its bias against the path tracer
@@ -38,7 +43,13 @@ nlohmann::json JobBook::status_of(const Job& job) const {
           {"approximate", job.plan.lut},
           {"priority", job.record.priority},
           {"progress",
-           {{"fraction", fraction}, {"samples_per_pixel", spp}, {"units_done", merged}, {"units_total", total}}},
+           {{"fraction", fraction},
+            {"samples_per_pixel", spp},
+            // The sample cap (quality.samples_per_pixel; 1048576 when only a
+            // target error or a time limit stops the render).
+            {"samples_per_pixel_target", job.request.quality.samples_per_pixel},
+            {"units_done", merged},
+            {"units_total", total}}},
           {"elapsed_s", elapsed},
           {"eta_s", eta},
           {"error",
@@ -55,6 +66,7 @@ nlohmann::json JobBook::status_of(const Job& job) const {
           {"finished_unix", is_terminal(job.record.state) ? nlohmann::json(job.record.finished_unix) : nlohmann::json()},
           // Finished longer than the retention ago: its files (images) are gone.
           {"expired", job.expired},
+          {"request", request},
           {"links",
            {{"self", self}, {"exr", self + "/image.exr"}, {"png", self + "/image.png"}, {"events", self + "/events"}}}};
 }

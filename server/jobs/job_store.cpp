@@ -62,12 +62,22 @@ JobStore::JobStore(const std::filesystem::path& database) : path_(database) {
       " id TEXT PRIMARY KEY, request TEXT NOT NULL, request_hash TEXT NOT NULL, priority INTEGER NOT NULL,"
       " state TEXT NOT NULL, created REAL NOT NULL, failure TEXT NOT NULL DEFAULT '',"
       " idempotency_key TEXT NOT NULL DEFAULT '', sequence INTEGER NOT NULL)");
+  add_name_column();
   exec(
       "CREATE TABLE IF NOT EXISTS job_ends ("
       " id TEXT PRIMARY KEY, finished REAL NOT NULL, expired INTEGER NOT NULL DEFAULT 0)");
 }
 
 JobStore::~JobStore() { sqlite3_close(db_); }
+
+// Databases made before names were kept have no "name" column: it is added,
+// every old job without a name ('').
+void JobStore::add_name_column() {
+  Statement columns(db_, "PRAGMA table_info(jobs)", path_);
+  while (columns.step())
+    if (columns.text(1) == "name") return;
+  exec("ALTER TABLE jobs ADD COLUMN name TEXT NOT NULL DEFAULT ''");
+}
 
 void JobStore::exec(const std::string& sql) {
   char* message = nullptr;
@@ -80,8 +90,8 @@ void JobStore::exec(const std::string& sql) {
 
 void JobStore::insert(const JobRecord& job) {
   Statement s(db_,
-              "INSERT INTO jobs (id, request, request_hash, priority, state, created, failure, idempotency_key, sequence)"
-              " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+              "INSERT INTO jobs (id, request, request_hash, priority, state, created, failure, idempotency_key, sequence,"
+              " name) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
               path_);
   s.bind(1, job.id);
   s.bind(2, job.request);
@@ -92,6 +102,7 @@ void JobStore::insert(const JobRecord& job) {
   s.bind(7, job.failure);
   s.bind(8, job.idempotency_key);
   s.bind(9, job.sequence);
+  s.bind(10, job.name);
   s.step();
 }
 
@@ -134,7 +145,7 @@ void JobStore::remove(const std::string& id) {
 std::vector<JobRecord> JobStore::load_all() const {
   Statement s(db_,
               "SELECT jobs.id, request, request_hash, priority, state, created, failure, idempotency_key, sequence,"
-              " COALESCE(job_ends.finished, 0), COALESCE(job_ends.expired, 0)"
+              " COALESCE(job_ends.finished, 0), COALESCE(job_ends.expired, 0), name"
               " FROM jobs LEFT JOIN job_ends ON job_ends.id = jobs.id ORDER BY sequence",
               path_);
   std::vector<JobRecord> jobs;
@@ -157,6 +168,7 @@ std::vector<JobRecord> JobStore::load_all() const {
     j.sequence = s.integer(8);
     j.finished_unix = s.real(9);
     j.expired = s.integer(10) != 0;
+    j.name = s.text(11);
     jobs.push_back(std::move(j));
   }
   return jobs;

@@ -1,7 +1,9 @@
 // The persistent record of jobs: an SQLite database in the data directory
 // (jobs and idempotency keys; when each finished job finished and whether its
 // files have expired, in a table of their own so that older databases
-// simply gain it).  Merged film tiles live next to it as files
+// simply gain it).  A job's name is a column of jobs that databases written
+// before it gain on opening (ALTER TABLE ... ADD COLUMN, default ''); the
+// name is not in the canonical request, so it is kept here.  Merged film tiles live next to it as files
 // (tile_merger.h).  Every write is a transaction; a failure to write (disk
 // full, read-only directory) throws StorageError naming the database.
 #pragma once
@@ -28,6 +30,7 @@ struct JobRecord {
   std::int64_t sequence = 0;  // submission order
   double finished_unix = 0.0;  // when it reached done, failed or cancelled; 0: not yet (or not known)
   bool expired = false;        // its files were removed after the retention (JobService)
+  std::string name;            // the request's "name" (api/job_name.h); "" when none
 };
 
 class JobStore {
@@ -48,6 +51,7 @@ class JobStore {
 
  private:
   void exec(const std::string& sql);
+  void add_name_column();
   std::filesystem::path path_;
   sqlite3* db_ = nullptr;
 };

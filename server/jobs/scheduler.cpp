@@ -30,6 +30,7 @@ void Scheduler::worker_left(const std::string& worker_id) {
 std::optional<UnitAssignment> Scheduler::next_unit(const std::string& worker_id) {
   auto& workers = book_.workers;
   if (auto w = workers.find(worker_id); w != workers.end()) w->second.last_seen = Clock::now();
+  if (book_.drained_workers.contains(worker_id)) return std::nullopt;
   Job* picked = nullptr;
   std::optional<WorkUnit> unit;
   // A job whose units left turn out to be received already has no work after
@@ -160,9 +161,17 @@ nlohmann::json Scheduler::workers() const {
                    {"version", field("version")},
                    {"units_done", w.units_done},
                    {"units_in_flight", w.in_flight},
+                   {"draining", book_.drained_workers.contains(id)},
                    {"last_seen_s", std::chrono::duration<double>(now - w.last_seen).count()}});
   }
   return out;
+}
+
+bool Scheduler::set_draining(const std::string& worker_id, bool draining) {
+  if (!book_.workers.contains(worker_id)) return false;
+  if (draining) book_.drained_workers.insert(worker_id);
+  else book_.drained_workers.erase(worker_id);
+  return true;
 }
 
 void Scheduler::requeue_late(Clock::time_point now) {

@@ -8,7 +8,7 @@
 // or a group's jobs: a timelapse's frames) with the fewest units in flight is
 // served next, so a small job is not stuck behind a huge one.  An adaptive
 // job hands out no unit beyond its pilot pass until its allocation is made
-// (result_intake.h).
+// (result_intake.h).  A worker an operator drained gets no unit at all.
 #pragma once
 #include <cstdint>
 #include <optional>
@@ -37,6 +37,9 @@ class Scheduler {
   void requeue_late(Clock::time_point now);
   // GET /v1/workers.
   nlohmann::json workers() const;
+  // Drains a worker (no new units; those in flight finish) or resumes it;
+  // false for a worker that is not connected.
+  bool set_draining(const std::string& worker_id, bool draining);
 
  private:
   // The job whose tenant is served next, or nullptr when no job has work.

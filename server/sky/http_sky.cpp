@@ -35,7 +35,7 @@ constexpr std::string_view kCommonParams[] = {"lat",     "lon",     "altitude", 
                                               "sun_azimuth", "preset", "ozone_du", "aod",  "aerosol",
                                               "albedo",  "min_nm",  "max_nm"};
 constexpr std::string_view kLookupParams[] = {"view_zenith", "view_azimuth"};
-constexpr std::string_view kEnvmapParams[] = {"width", "sun"};
+constexpr std::string_view kEnvmapParams[] = {"width", "sun", "layout", "color_space", "units"};
 
 // The probe's field paths -> the query parameters they came from.
 struct PathName {
@@ -102,6 +102,13 @@ int bins_for(double min_nm, double max_nm, int base_bins) {
   const double n = std::round(double(std::max(1, base_bins)) * (max_nm - min_nm) / kBaseRangeNm);
   return static_cast<int>(std::clamp(n, double(kMinBins), double(kMaxBins)));
 }
+
+// skyfarm:layout, the mapping and its axes in words.
+constexpr const char* kLatlongLayoutText = "latlong: centre = north (azimuth 0), right = east, top = zenith";
+constexpr const char* kEqualAreaLayoutText =
+    "equal_area: Clarberg octahedral, as pbrt-v4 imagemap; pixel (x, y) -> u = (x + 1/2) / width, "
+    "v = (y + 1/2) / width (y down) -> direction (x, y, z) = (east, north, zenith): centre = zenith, "
+    "below it north, right of it east, corners = nadir; every pixel 4 pi / width^2 sr";
 
 const char* sun_mode_name(EnvmapSun mode) {
   switch (mode) {
@@ -251,6 +258,29 @@ SkyQuery parse_sky_query(const QueryParams& params, SkyRoute route, int base_spe
       else if (*s == "separate") out.sun_mode = EnvmapSun::kSeparate;
       else q.error("sun", "must be one of disk, none, separate", quote_value(*s));
     }
+    if (const auto l = q.text("layout")) {
+      if (*l == "latlong") out.layout = EnvmapLayout::kLatlong;
+      else if (*l == "equal_area") out.layout = EnvmapLayout::kEqualArea;
+      else q.error("layout", "must be one of latlong, equal_area", quote_value(*l));
+    }
+    // A square map of width^2 pixels: bounded like the lat-long ones' pixel count.
+    if (out.layout == EnvmapLayout::kEqualArea && out.width > kEnvmapMaxWidthEqualArea)
+      q.error("width", "must be at most " + std::to_string(kEnvmapMaxWidthEqualArea) + " with layout=equal_area",
+              std::to_string(out.width));
+    // The names of the render request's output.color_space / output.units.
+    auto names_of = [](const auto& names) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + std::string(n.first);
+      return list;
+    };
+    if (const auto c = q.text("color_space")) {
+      if (const auto v = color_space_named(*c)) out.color_space = *v;
+      else q.error("color_space", "must be one of " + names_of(kColorSpaceNames), quote_value(*c));
+    }
+    if (const auto u = q.text("units")) {
+      if (const auto v = units_named(*u)) out.units = *v;
+      else q.error("units", "must be one of " + names_of(kRadiometricUnitsNames), quote_value(*u));
+    }
   }
 
   std::optional<api::ProbeRequest> probe;
@@ -336,6 +366,10 @@ Json SkyQuery::canonical_json(SkyRoute route) const {
   } else {
     j["width"] = width;
     j["sun_mode"] = sun_mode_name(sun_mode);
+    if (layout == EnvmapLayout::kEqualArea) j["layout"] = "equal_area";
+    // Only when not the default: the maps of before keep their key and ETag.
+    if (color_space != ColorSpace::kLinRec709) j["color_space"] = std::string(name_of(color_space));
+    if (units != RadiometricUnits::kCdM2) j["units"] = std::string(name_of(units));
   }
   return j;
 }
@@ -391,7 +425,9 @@ void SkyHttp::envmap(const httplib::Request& req, httplib::Response& res) const 
   SkyService& service = *service_;
   const std::shared_ptr<const EnvmapFile> file = service.envmap(key, [&] {
     const std::shared_ptr<const SkyTable> table = service.table(q.table);
-    Image image = render_envmap(*table, q.width, q.sun_mode, service.options().envmap_threads);
+    const bool latlong = q.layout == EnvmapLayout::kLatlong;
+    Image image = latlong ? render_envmap(*table, q.width, q.sun_mode, service.options().envmap_threads)
+                          : render_envmap_equal_area(*table, q.width, q.sun_mode, service.options().envmap_threads);
     namespace mk = metadata_key;
     image.set_metadata(mk::kMethod, std::string("lut"));
     image.set_metadata(mk::kApproximate, std::string("true"));
@@ -405,7 +441,7 @@ void SkyHttp::envmap(const httplib::Request& req, httplib::Response& res) const 
     image.set_metadata(mk::kWavelengthMinNm, q.min_nm);
     image.set_metadata(mk::kWavelengthMaxNm, q.max_nm);
     image.set_metadata(mk::kObserverAltitudeM, q.location.altitude_m);
-    image.set_metadata(mk::kLayout, std::string("latlong: centre = north (azimuth 0), right = east, top = zenith"));
+    image.set_metadata(mk::kLayout, std::string(latlong ? kLatlongLayoutText : kEqualAreaLayoutText));
     if (q.sun_mode == EnvmapSun::kSeparate) {
       const SunDiskSummary disk = sun_disk_summary(*table);
       image.set_metadata(mk::kSunDiskX, disk.xyz.x);
@@ -419,7 +455,7 @@ void SkyHttp::envmap(const httplib::Request& req, httplib::Response& res) const 
       const glm::dvec3& d = table->sun.direction();
       image.set_metadata(mk::kSunDirection, exact_decimal(d.x) + "," + exact_decimal(d.y) + "," + exact_decimal(d.z));
     }
-    return encode_envmap_exr(image);
+    return encode_envmap_exr(image, latlong, q.color_space, q.units);
   });
   if (not_modified(req, res, file->etag, cache_control_)) return;
   res.status = 200;

@@ -28,7 +28,16 @@
 //   envmap only:    width, even, [8, 8192], default 1024 (height = width / 2);
 //                   at most 1024 for an observer above the atmosphere's top
 //                   (100 km), where every pixel is a ray march (~3 s at 1024);
-//                   sun = disk (default) | none | separate
+//                   sun = disk (default) | none | separate;
+//                   layout = latlong (default) | equal_area: a width x width
+//                   square in the equal-area octahedral mapping of pbrt-v4's
+//                   `imagemap` infinite light (sky_service.h), width at most
+//                   4096;
+//                   color_space = lin_rec709 (default) | acescg | aces2065-1
+//                   | cie_xyz and units = cd_m2 (default) | relative |
+//                   w_m2_sr, as the render request's output.color_space and
+//                   output.units (common/image/color_management.h; relative
+//                   meters the map's own median luminance)
 // Anything else is a 400 naming the unknown parameter; every invalid value
 // is a 400 problem whose errors[].field is the query parameter's name.
 //
@@ -50,8 +59,11 @@
 // "true", sun_zenith_deg, sun_azimuth_deg, earth_sun_distance_au (and
 // sun_earth_distance_au, its deprecated alias), sun_angular_radius_deg,
 // sun_mode, wavelength_min_nm, wavelength_max_nm, observer_altitude_m,
-// layout, request (the canonical parameters as JSON), software_version
-// (docs/exr-metadata.md).  sun =
+// request (the canonical parameters as JSON), software_version, layout (the
+// mapping and its axes, in words; docs/exr-metadata.md).  With
+// layout=equal_area the image is width x width, has no `envmap` attribute
+// (OpenEXR names only latlong and cube maps) and skyfarm:layout begins
+// "equal_area".  sun =
 //   disk       the disk in the pixels, integrated over each pixel (its energy
 //              is exact at any width; sky_service.h)
 //   none       no disk
@@ -61,7 +73,9 @@
 //              sun_disk_solid_angle_sr, sun_disk_illuminance_lux (normal
 //              illuminance from the disk), sun_direction ("x,y,z" in the
 //              observer frame: x east, y north, z up) - what a renderer needs
-//              for a distant light.
+//              for a distant light.  These stay linear Rec.709 / XYZ in
+//              cd/m^2 whatever color_space and units say; skyfarm:units_scale
+//              converts them.
 //
 // Both: strong ETag (a hash of the body), If-None-Match -> 304, and
 // Cache-Control "public, max-age=3600" ("private, max-age=3600" when the API
@@ -77,6 +91,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/atmosphere/atmosphere_spec.h"
+#include "common/image/color_management.h"
 #include "common/sun/sun_spec.h"
 #include "common/sun/utc_time.h"
 #include "server/sky/sky_service.h"
@@ -97,6 +112,10 @@ inline constexpr int kEnvmapMinWidth = 8;
 inline constexpr int kEnvmapMaxWidth = 8192;
 inline constexpr int kEnvmapDefaultWidth = 1024;
 inline constexpr int kEnvmapMaxWidthAboveAtmosphere = 1024;
+// width x width pixels: 4096 holds about as many as the widest lat-long map.
+inline constexpr int kEnvmapMaxWidthEqualArea = 4096;
+
+enum class EnvmapLayout { kLatlong, kEqualArea };
 
 // A validated query, defaults filled in.
 struct SkyQuery {
@@ -108,10 +127,14 @@ struct SkyQuery {
   double view_zenith_deg = 0.0, view_azimuth_deg = 0.0;  // lookup
   int width = kEnvmapDefaultWidth;                        // envmap
   EnvmapSun sun_mode = EnvmapSun::kDisk;                  // envmap
+  EnvmapLayout layout = EnvmapLayout::kLatlong;           // envmap
+  ColorSpace color_space = ColorSpace::kLinRec709;        // envmap
+  RadiometricUnits units = RadiometricUnits::kCdM2;       // envmap
   // What the table is built from: the sun resolved (from time, or the angles).
   SkyTableParams table;
 
-  // The canonical parameters (every default filled in, one spelling).
+  // The canonical parameters (every default filled in, one spelling; the
+  // layout only when it is not latlong, so older maps keep their bytes).
   nlohmann::json canonical_json(SkyRoute route) const;
 };
 

@@ -23,6 +23,7 @@
 #include "api/json_fields.h"
 #include "common/atmosphere/atmosphere_builder.h"
 #include "common/camera/camera.h"
+#include "common/geometry/equal_area.h"
 #include "common/image/exr_writer.h"
 #include "common/render/parallel.h"
 #include "common/sun/solar_spectrum.h"
@@ -263,7 +264,67 @@ Image render_envmap(const SkyTable& table, int width, EnvmapSun sun_mode, int th
   return image;
 }
 
-std::string encode_envmap_exr(const Image& image) {
+Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun_mode, int threads) {
+  if (width < 2 || width % 2 != 0) throw std::invalid_argument("envmap: width must be even and >= 2");
+  const int n = width;
+  Image image(n, n);
+  const LutSky& sky = table.sky;
+  const std::size_t B = static_cast<std::size_t>(sky.grid().size());
+  const double inv_n = 1.0 / double(n);
+
+  // The sky: the mean of k x k stratified look-ups per pixel (each stratum
+  // holds the same solid angle, so the plain mean is the mean over the pixel).
+  constexpr int k = kEqualAreaSkySamples;
+  parallel_for(static_cast<std::size_t>(n), threads, [&](std::size_t row, int) {
+    std::vector<double> L(B), sum(B);
+    const int y = static_cast<int>(row);
+    for (int x = 0; x < n; ++x) {
+      std::fill(sum.begin(), sum.end(), 0.0);
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; j < k; ++j) {
+          const glm::dvec2 p((x + (i + 0.5) / k) * inv_n, (y + (j + 0.5) / k) * inv_n);
+          sky.radiance(equal_area_square_to_sphere(p), L, false);
+          for (std::size_t b = 0; b < B; ++b) sum[b] += L[b];
+        }
+      for (double& v : sum) v /= double(k) * double(k);
+      image.set_xyz(x, y, table.xyz(sum));
+    }
+  });
+
+  // The disk, splatted as in render_envmap: exact energy at any resolution.
+  const Sun& sun = table.sun;
+  if (sun_mode == EnvmapSun::kDisk && !sun.is_point()) {
+    const double pixel_sr = equal_area_pixel_solid_angle(n);
+    const int m = disk_sample_side(sun.solid_angle_sr() / pixel_sr);
+    const double weight = sun.solid_angle_sr() / (double(m) * double(m));  // sr per sample
+    std::vector<double> with(B), without(B);
+    std::unordered_map<std::uint64_t, std::vector<double>> splats;  // pixel -> sum of L T dOmega per bin
+    double pdf = 0.0;
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < m; ++j) {
+        const glm::dvec3 d = sun.sample_direction((i + 0.5) / m, (j + 0.5) / m, &pdf);
+        const glm::dvec2 p = equal_area_sphere_to_square(d);
+        const int px = std::clamp(static_cast<int>(p.x * n), 0, n - 1);
+        const int py = std::clamp(static_cast<int>(p.y * n), 0, n - 1);
+        disk_radiance(sky, d, with, without);
+        auto& acc = splats[static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(n) +
+                           static_cast<std::uint64_t>(px)];
+        if (acc.empty()) acc.assign(B, 0.0);
+        for (std::size_t b = 0; b < B; ++b) acc[b] += with[b] * weight;
+      }
+    for (auto& [index, acc] : splats) {
+      const int px = static_cast<int>(index % static_cast<std::uint64_t>(n));
+      const int py = static_cast<int>(index / static_cast<std::uint64_t>(n));
+      for (double& v : acc) v /= pixel_sr;
+      const Rgb disk = xyz_to_linear_srgb(table.xyz(acc));
+      const auto old = image.rgb(px, py);
+      image.set_rgb(px, py, Rgb{old[0] + disk.r, old[1] + disk.g, old[2] + disk.b});
+    }
+  }
+  return image;
+}
+
+std::string encode_envmap_exr(const Image& image, bool latlong, ColorSpace color_space, RadiometricUnits units) {
   namespace fs = std::filesystem;
   const fs::path path = fs::temp_directory_path() / ("skyfarm-envmap-" + std::to_string(::getpid()) + "-" +
                                                       std::to_string(g_temp_counter.fetch_add(1)) + ".exr");
@@ -275,7 +336,9 @@ std::string encode_envmap_exr(const Image& image) {
   // 1024: 8.4 MB in 0.33 s against 10.7 MB in 0.41 s; OpenEXR compresses on
   // one thread here).
   options.compression = ExrCompression::kPiz;
-  options.latlong_envmap = true;
+  options.latlong_envmap = latlong;
+  options.color_space = color_space;
+  options.units = units;  // relative: the map's own automatic exposure
   struct Remove {
     fs::path p;
     ~Remove() {

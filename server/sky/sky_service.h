@@ -37,6 +37,14 @@
 // carrying L_disk T (Omega_disk / N), added to the pixel it falls in and
 // divided by that pixel's solid angle, so the disk's energy in the map is
 // exact whatever the resolution (a disk smaller than a pixel included).
+// Equal-area maps (render_envmap_equal_area): a width x width square in the
+// octahedral mapping of common/geometry/equal_area.h, the layout of pbrt-v4's
+// `imagemap` infinite light, read in the observer frame (x east, y north, z
+// zenith: the zenith at the centre, north below it, east to its right, the
+// nadir at the corners).  Every pixel holds 4 pi / width^2 sr, so each holds
+// the MEAN radiance over its solid angle: the sky is averaged over
+// kEqualAreaSkySamples^2 stratified directions per pixel (uniform in the
+// square is uniform in solid angle), and the disk is splatted as above.
 // Values: linear Rec.709 (D65) in absolute units, Y in cd/m^2, as the
 // renders' Image::set_xyz.
 #pragma once
@@ -57,6 +65,7 @@
 
 #include "common/atmosphere/atmosphere_spec.h"
 #include "common/film/image.h"
+#include "common/image/color_management.h"
 #include "common/lut/lut_sky.h"
 #include "common/lut/spectral_grid.h"
 #include "common/spectrum/color.h"
@@ -132,9 +141,19 @@ SunDiskSummary sun_disk_summary(const SkyTable& table, int samples = 64);
 // the disk is in the pixels.  `threads` <= 0: all cores.
 Image render_envmap(const SkyTable& table, int width, EnvmapSun sun, int threads = 0);
 
-// The image as a FLOAT, PIZ-compressed (lossless) OpenEXR with the latlong envmap
-// attribute, as bytes (written through a temporary file).
-std::string encode_envmap_exr(const Image& image);
+// Strata per side of the sky's samples in each equal-area pixel.
+inline constexpr int kEqualAreaSkySamples = 2;
+
+// A width x width equal-area map of `table` (layout above).
+Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun, int threads = 0);
+
+// The image as a FLOAT, PIZ-compressed (lossless) OpenEXR, as bytes (written
+// through a temporary file); `latlong`: with the standard `envmap` attribute
+// LATLONG (OpenEXR has no name for the equal-area layout); R, G, B in the
+// colour space and units asked for (exr_writer.h).
+std::string encode_envmap_exr(const Image& image, bool latlong = true,
+                              ColorSpace color_space = ColorSpace::kLinRec709,
+                              RadiometricUnits units = RadiometricUnits::kCdM2);
 
 // --- The caches ----------------------------------------------------------------
 

@@ -1,5 +1,6 @@
 #include "server/timelapse/timelapse_outputs.h"
 
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -21,17 +22,40 @@ Image load_frame(const fs::path& exr_path) {
   const auto r = exr.channels.find("R"), g = exr.channels.find("G"), b = exr.channels.find("B");
   if (r == exr.channels.end() || g == exr.channels.end() || b == exr.channels.end())
     throw std::runtime_error(exr_path.string() + " has no R, G, B channels");
+  const std::size_t n = static_cast<std::size_t>(exr.width) * static_cast<std::size_t>(exr.height);
+  std::vector<float> rgb(3 * n);
+  for (std::size_t i = 0; i < n; ++i) {
+    rgb[3 * i] = r->second.values[i];
+    rgb[3 * i + 1] = g->second.values[i];
+    rgb[3 * i + 2] = b->second.values[i];
+  }
+  // A frame written in another colour space or other units (output.color_space,
+  // output.units) back to linear Rec.709 in cd/m^2, what the PNG expects.
+  const std::string prefix = kExrMetadataPrefix;
+  const std::string color_space_key = prefix + "color_space", units_key = prefix + "units",
+                    units_scale_key = prefix + "units_scale";
+  if (const auto it = exr.string_attributes.find(color_space_key); it != exr.string_attributes.end()) {
+    const std::optional<ColorSpace> space = color_space_named(it->second);
+    if (!space) throw std::runtime_error(exr_path.string() + ": unknown colour space '" + it->second + "'");
+    convert_color_space(*space, ColorSpace::kLinRec709, rgb.data(), n);
+  }
+  double to_cd_m2 = 1.0;
+  if (const auto it = exr.number_attributes.find(units_scale_key); it != exr.number_attributes.end()) {
+    if (!(it->second > 0.0) || !std::isfinite(it->second))
+      throw std::runtime_error(exr_path.string() + ": bad " + units_scale_key);
+    to_cd_m2 = 1.0 / it->second;
+  }
   Image image(exr.width, exr.height);
   for (int y = 0; y < exr.height; ++y)
     for (int x = 0; x < exr.width; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(exr.width) + static_cast<std::size_t>(x);
-      image.set_rgb(x, y, Rgb{r->second.values[i], g->second.values[i], b->second.values[i]});
+      image.set_rgb(x, y, Rgb{to_cd_m2 * rgb[3 * i], to_cd_m2 * rgb[3 * i + 1], to_cd_m2 * rgb[3 * i + 2]});
     }
-  const std::string prefix = kExrMetadataPrefix;
   for (const auto& [key, value] : exr.string_attributes)
-    if (key.starts_with(prefix)) image.set_metadata(key.substr(prefix.size()), value);
+    if (key.starts_with(prefix) && key != color_space_key && key != units_key)
+      image.set_metadata(key.substr(prefix.size()), value);
   for (const auto& [key, value] : exr.number_attributes)
-    if (key.starts_with(prefix)) image.set_metadata(key.substr(prefix.size()), value);
+    if (key.starts_with(prefix) && key != units_scale_key) image.set_metadata(key.substr(prefix.size()), value);
   return image;
 }
 
@@ -78,6 +102,7 @@ OutputsReport build_timelapse_outputs(const std::vector<FrameInput>& frames, con
     image.set_metadata(metadata_key::kTimelapseFrameTime, frames[i].label);
     PngWriteOptions png;
     png.exposure_ev = report.ev100[i];
+    png.view = settings.view;
     write_png(image, frame_png_path(dir, static_cast<int>(i)), png);
     if (!sheet) sheet.emplace(static_cast<int>(frames.size()), image.width(), image.height());
     sheet->add(static_cast<int>(i), image, report.ev100[i], frames[i].label);

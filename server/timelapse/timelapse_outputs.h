@@ -13,6 +13,8 @@
 //                      EV100; none: each frame's automatic EV100 smoothed over
 //                      smoothing_frames frames (timelapse_exposure.h)
 //   smoothing_frames   odd, >= 1
+//   view               output.view of the request: the frames' PNG view
+//                      (color_management.h; the contact sheet stays srgb)
 //   fps                the video's frame rate
 //   ffmpeg             the server's --ffmpeg (find_ffmpeg); looked up here, so
 //                      an ffmpeg installed while the server runs is used
@@ -27,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "common/image/color_management.h"
+
 namespace skyfarm::server {
 
 struct FrameInput {
@@ -37,6 +41,7 @@ struct FrameInput {
 struct OutputSettings {
   std::optional<double> fixed_ev100;
   int smoothing_frames = 5;
+  DisplayView view = DisplayView::kSrgb;
   int fps = 24;
   std::string ffmpeg;
   std::chrono::seconds ffmpeg_timeout{600};

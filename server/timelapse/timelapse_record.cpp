@@ -28,7 +28,7 @@ T field(const nlohmann::json& j, const char* name) {
 }  // namespace
 
 nlohmann::json record_json(const TimelapseRecord& r) {
-  return {{"version", kVersion},
+  nlohmann::json j = {{"version", kVersion},
           {"id", r.id},
           {"request", r.request},
           {"sequence", r.sequence},
@@ -42,6 +42,8 @@ nlohmann::json record_json(const TimelapseRecord& r) {
           {"video", r.video},
           {"video_reason", r.video_reason},
           {"finished_unix", r.finished_unix}};
+  if (!r.name.empty()) j["name"] = r.name;
+  return j;
 }
 
 TimelapseRecord record_from_json(const nlohmann::json& j) {
@@ -65,6 +67,7 @@ TimelapseRecord record_from_json(const nlohmann::json& j) {
   r.video = field<bool>(j, "video");
   r.video_reason = field<std::string>(j, "video_reason");
   r.finished_unix = field<double>(j, "finished_unix");
+  if (j.contains("name")) r.name = field<std::string>(j, "name");
   return r;
 }
 

@@ -8,7 +8,8 @@
 // "sequence", "created_unix", "state", "failure", "idempotency_key",
 // "render_ids" (per frame; "" while not submitted), "exposure_ev100" (per
 // frame, once the outputs are built), "contact_sheet" (bool), "video" (bool),
-// "video_reason", "finished_unix", "version" (1)}.
+// "video_reason", "finished_unix", "version" (1)}, and "name" when the
+// request gave one (records written before names were kept have none).
 #pragma once
 #include <cstdint>
 #include <filesystem>
@@ -35,6 +36,7 @@ struct TimelapseRecord {
   bool video = false;
   std::string video_reason;  // when done without a video
   double finished_unix = 0.0;
+  std::string name;  // the request's "name" (api/job_name.h; not in `request`); "" when none
 };
 
 nlohmann::json record_json(const TimelapseRecord& record);

@@ -49,6 +49,7 @@ TimelapseService::TimelapseService(JobService& jobs, fs::path data_dir, Timelaps
     try {
       // A record is re-read without the frame cap: it was accepted under the cap of its day.
       t->request = api::parse_timelapse_request(r.request.dump(), INT_MAX);
+      if (!r.name.empty()) t->request.base.name = r.name;  // not in the canonical request: its frames' names
     } catch (const std::exception& e) {
       problems.push_back(r.id + ": its request no longer reads: " + e.what());
       continue;
@@ -249,6 +250,7 @@ void TimelapseService::build_outputs(const std::string& id) {
     const Entry& t = *timelapses_.at(id);
     settings.fixed_ev100 = t.request.base.output.exposure_ev;
     settings.smoothing_frames = t.request.exposure_smoothing_frames;
+    settings.view = t.request.base.output.view;
     settings.fps = t.request.video_fps;
     settings.ffmpeg = options_.ffmpeg;
     settings.ffmpeg_timeout = options_.ffmpeg_timeout;
@@ -324,6 +326,7 @@ SubmitResult TimelapseService::submit(const api::TimelapseRequest& request, cons
   t->record.sequence = next_sequence_++;
   t->record.created_unix = unix_now();
   t->record.idempotency_key = key.value_or("");
+  t->record.name = request.base.name.value_or("");
   t->record.render_ids.assign(static_cast<std::size_t>(request.frame_count), "");
   save_record(root_, t->record);  // StorageError: 507, nothing kept
   const std::string id = t->record.id;
@@ -403,6 +406,7 @@ nlohmann::json TimelapseService::status_of(const Entry& t) const {
   if (t.active()) stage = t.building || done == n ? "making_outputs" : "rendering";
   const auto& exposure = t.request.base.output.exposure_ev;
   return {{"id", t.record.id},
+          {"name", t.record.name.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.record.name)},
           {"state", to_string(state)},
           {"stage", stage},
           {"failure", t.record.failure.empty() ? nlohmann::json(nullptr) : nlohmann::json(t.record.failure)},

@@ -354,11 +354,12 @@ TEST(RenderRequestErrors, UnknownFieldsAreRejectedAtEveryLevel) {
   for (const auto& [body, message] : std::vector<std::pair<std::string, std::string>>{
            {with(R"("colour": 1)"),
             "colour: unknown field (allowed: location, time, sun, camera, atmosphere, spectral, quality, method, "
-            "output, seed, priority, objects, clouds)"},
+            "output, seed, priority, objects, clouds, name)"},
            {with(R"("quality": {"spp": 4})"),
             "quality.spp: unknown field (allowed: samples_per_pixel, target_relative_error, time_limit_s, adaptive)"},
            {with(R"("output": {"png": true})"),
-            "output.png: unknown field (allowed: exposure_ev, spectral_channels, error_layer, half)"},
+            "output.png: unknown field (allowed: exposure_ev, spectral_channels, error_layer, half, color_space, units, "
+            "view)"},
            {with(R"("spectral": {"step_nm": 5})"), "spectral.step_nm: unknown field (allowed: min_nm, max_nm, batches)"},
            {with(R"("atmosphere": {"aerosol": {"type": "urban"}})"),
             "atmosphere.aerosol.type: unknown field (allowed: optical_depth_550, angstrom_exponent, asymmetry, "
@@ -669,6 +670,50 @@ TEST(RenderRequestCanonical, AdaptiveOnlyWhenAsked) {
   const std::vector<FieldError> errors = errors_of(with(R"("quality": {"adaptive": "yes"})"));
   ASSERT_EQ(errors.size(), 1u);
   EXPECT_EQ(errors[0].path, "quality.adaptive");
+}
+
+// output.color_space, output.units and output.view (color_management.h):
+// every name parses, defaults stay out of the canonical text (so requests
+// written before them keep their hash), and a bad name is an error naming the field.
+TEST(RenderRequestOutputColor, NamesParseAndDefaultsStayOutOfTheCanonicalText) {
+  const RenderRequest plain = parse_render_request(with(""));
+  EXPECT_EQ(plain.output.color_space, ColorSpace::kLinRec709);
+  EXPECT_EQ(plain.output.units, RadiometricUnits::kCdM2);
+  EXPECT_EQ(plain.output.view, DisplayView::kSrgb);
+  const nlohmann::json c = to_canonical_json(plain);
+  for (const char* key : {"color_space", "units", "view"}) EXPECT_FALSE(c["output"].contains(key)) << key;
+  EXPECT_EQ(canonical_text(plain), canonical_text(parse_render_request(with(
+                                       R"("output": {"color_space": "lin_rec709", "units": "cd_m2", "view": "srgb"})"))));
+
+  const std::pair<const char*, ColorSpace> spaces[] = {{"acescg", ColorSpace::kAcesCg},
+                                                       {"aces2065-1", ColorSpace::kAces2065_1},
+                                                       {"cie_xyz", ColorSpace::kCieXyz}};
+  for (const auto& [name, space] : spaces) {
+    const RenderRequest r = parse_render_request(with(std::string(R"("output": {"color_space": ")") + name + "\"}"));
+    EXPECT_EQ(r.output.color_space, space) << name;
+    EXPECT_EQ(to_canonical_json(r)["output"]["color_space"], name);
+    EXPECT_EQ(parse_render_request(canonical_text(r)).output.color_space, space) << name;
+    EXPECT_NE(canonical_text(r), canonical_text(plain)) << name;
+  }
+  const RenderRequest r = parse_render_request(with(R"("output": {"units": "relative", "view": "aces"})"));
+  EXPECT_EQ(r.output.units, RadiometricUnits::kRelative);
+  EXPECT_EQ(r.output.view, DisplayView::kAces);
+  EXPECT_EQ(to_canonical_json(r)["output"]["units"], "relative");
+  EXPECT_EQ(to_canonical_json(r)["output"]["view"], "aces");
+  EXPECT_EQ(parse_render_request(with(R"("output": {"units": "w_m2_sr"})")).output.units, RadiometricUnits::kWM2Sr);
+}
+
+TEST(RenderRequestOutputColor, UnknownNamesAreErrorsNamingTheField) {
+  EXPECT_EQ(messages_of(with(R"("output": {"color_space": "srgb"})")),
+            std::vector<std::string>{
+                "output.color_space: must be one of lin_rec709, acescg, aces2065-1, cie_xyz, got \"srgb\""});
+  EXPECT_EQ(messages_of(with(R"("output": {"units": "nits"})")),
+            std::vector<std::string>{"output.units: must be one of cd_m2, relative, w_m2_sr, got \"nits\""});
+  EXPECT_EQ(messages_of(with(R"("output": {"view": "agx"})")),
+            std::vector<std::string>{"output.view: must be one of srgb, aces, got \"agx\""});
+  const std::vector<FieldError> errors = errors_of(with(R"("output": {"color_space": 709})"));
+  ASSERT_EQ(errors.size(), 1u);
+  EXPECT_EQ(errors[0].path, "output.color_space");
 }
 
 TEST(RenderRequestCanonical, CustomAtmosphereKeepsOnlyItsFields) {

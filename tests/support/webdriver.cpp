@@ -181,6 +181,10 @@ Json WebDriver::command(const std::string& method, const std::string& path, cons
 
 void WebDriver::navigate(const std::string& url) { command("POST", "/session/" + session_ + "/url", {{"url", url}}); }
 
+void WebDriver::set_window_size(int width, int height) {
+  command("POST", "/session/" + session_ + "/window/rect", {{"width", width}, {"height", height}});
+}
+
 Element WebDriver::find(const std::string& css) {
   const Json value = command("POST", "/session/" + session_ + "/element", {{"using", "css selector"}, {"value", css}});
   return Element{value.at(kElementKey).get<std::string>()};

@@ -64,6 +64,9 @@ class WebDriver {
   const std::string& error() const { return error_; }
 
   void navigate(const std::string& url);
+  // The browser window's outer size in CSS pixels (WebDriver "Set Window
+  // Rect"); headless Chromium makes its viewport that size.
+  void set_window_size(int width, int height);
   // The first element matching a CSS selector (throws "no such element").
   Element find(const std::string& css);
   void clear(const Element& e);

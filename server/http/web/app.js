@@ -1,8 +1,12 @@
-// skyfarm's web page: submit a render or a timelapse, watch it converge, list
-// renders, timelapses and workers.  Plain ES module, no dependencies; it talks
-// only to this server's API (api/openapi.yaml):
+// skyfarm's web page, an operator's console: submit a render or a timelapse
+// (from the form or as JSON), watch it converge, list renders and timelapses
+// by name with a thumbnail, filter them by state, see what each asked for,
+// duplicate or re-submit it, drain and resume workers.  Plain ES module, no
+// dependencies; it talks only to this server's API (api/openapi.yaml):
 //
 //   POST /v1/renders, /v1/timelapses          the form (400 problems shown by field)
+//   POST /v1/workers/{id}/drain, .../resume   the workers' Drain / Resume buttons
+//   GET  /v1/renders/{id}/image.png?width=N   the list's thumbnails (done renders)
 //   GET  /v1/renders/{id}/events              Server-Sent Events, read with fetch() so
 //                                             that a bearer token can be sent
 //   GET  /v1/renders/{id}[/image.png]         status, progressive image (409 until the
@@ -26,6 +30,10 @@ const kStreamRetryMs = 1000;
 // at most one fetch a second while a render runs (and one for the final image).
 const kImageIntervalMs = 1000;
 const kThumbnailFetches = 3;  // frame images fetched at once
+const kListThumbnailWidth = 96;  // px, the render list's thumbnails
+// quality.samples_per_pixel when only a target error or a time limit stops a
+// render (api/render_request.h kMaxSamplesPerPixel): no cap worth showing.
+const kUncappedSamples = 1048576;
 const kTokenKey = "skyfarm-token";
 const kSvgNs = "http://www.w3.org/2000/svg";
 const kTerminal = new Set(["done", "failed", "cancelled"]);
@@ -103,6 +111,61 @@ function seconds(s) {
 }
 
 function shortId(id) { return id.length > 14 ? `${id.slice(0, 12)}…` : id; }
+
+// Samples per pixel as people count them: "12.5 of 64 spp"; a render that
+// stops by a target error or a time limit alone has no cap, so it says that.
+function samplesText(progress, request) {
+  const done = progress?.samples_per_pixel;
+  if (!isNumber(done)) return "";
+  const doneText = `${+done.toFixed(1)}`;
+  const target = progress.samples_per_pixel_target;
+  const q = request?.quality || {};
+  if (isNumber(target) && target < kUncappedSamples) return `${doneText} of ${target} spp`;
+  const stops = [isNumber(q.target_relative_error) ? `to ${percent(q.target_relative_error, 1)} error` : "",
+    isNumber(q.time_limit_s) ? `for at most ${seconds(q.time_limit_s)}` : ""].filter(Boolean);
+  return `${doneText} spp` + (stops.length ? ` (${stops.join(", ")})` : "");
+}
+
+const degrees = (x, pos, neg) => `${Math.abs(x).toFixed(2)}° ${x < 0 ? neg : pos}`;
+
+// "42.44° N, 76.48° W" from a request's location.
+function placeText(request) {
+  const l = request?.location;
+  if (!l || !isNumber(l.latitude_deg) || !isNumber(l.longitude_deg)) return "";
+  return `${degrees(l.latitude_deg, "N", "S")}, ${degrees(l.longitude_deg, "E", "W")}`;
+}
+
+// "2013-05-28 00:25 UTC" (canonical requests give the time in UTC), or the
+// sun's angles when the request gave them.
+function timeText(request) {
+  const clock = (t) => t.replace(/(T\d\d:\d\d):00(?=[Z+-]|$)/, "$1").replace("T", " ").replace(/Z$/i, " UTC").replace(/([+-]\d\d:?\d\d)$/, " $1");
+  if (typeof request?.time === "string") return clock(request.time);
+  if (typeof request?.start === "string") return `${clock(request.start)} to ${clock(request.end || "")}`;
+  const sun = request?.sun;
+  if (sun && isNumber(sun.zenith_deg)) return `sun at zenith ${sun.zenith_deg}°, azimuth ${sun.azimuth_deg ?? 0}°`;
+  return "";
+}
+
+function cameraText(request) {
+  const c = request?.camera;
+  return c ? `${c.projection} ${c.width}×${c.height}` : "";
+}
+
+// A render's or timelapse's title: its name, else what it shows.
+function titleOf(item) {
+  if (item.name) return item.name;
+  const place = placeText(item.request), time = timeText(item.request);
+  return place || time ? `Sky over ${[place, time].filter(Boolean).join(", ")}` : `Render ${shortId(item.id)}`;
+}
+
+// The request an item asked for, with its name (which the canonical request
+// leaves out): what Duplicate and Re-submit send.
+function requestOf(item) {
+  if (!item?.request) return null;
+  const body = structuredClone(item.request);
+  if (item.name) body.name = item.name;
+  return body;
+}
 
 function element(tag, props = {}, children = []) {
   const node = document.createElement(tag);
@@ -321,19 +384,118 @@ async function submitForm(event) {
     error.input.focus();
     return;
   }
-  const button = $("#submit");
-  button.disabled = true;
+  await submitBody(kind(), body, $("#submit"));
+}
+
+// POSTs a render ("render") or timelapse ("timelapse") body and shows what
+// the server made of it (a 400 problem next to the form's fields).
+async function submitBody(what, body, button) {
+  if (button) button.disabled = true;
   try {
-    const path = kind() === "render" ? "/v1/renders" : "/v1/timelapses";
+    const path = what === "render" ? "/v1/renders" : "/v1/timelapses";
     const res = await api(path, { method: "POST", body });
-    if (!res.ok) { showProblem(res.data, res.status); return; }
-    const hash = kind() === "render" ? `#render=${res.data.id}` : `#timelapse=${res.data.id}`;
+    if (!res.ok) { showProblem(res.data, res.status); return false; }
+    const hash = what === "render" ? `#render=${res.data.id}` : `#timelapse=${res.data.id}`;
     if (location.hash === hash) showFromHash(); else location.hash = hash;  // the same id again: no hashchange
     refreshLists();
+    return true;
   } finally {
-    button.disabled = false;
+    if (button) button.disabled = false;
   }
 }
+
+// A timelapse body has a start; a render body has none.
+const kindOfBody = (body) => (body && typeof body === "object" && "start" in body ? "timelapse" : "render");
+
+// --- Duplicate: a request back into the form and the JSON editor ----------------
+
+// "2013-05-27T09:30:00-04:00" -> ["2013-05-27T09:30:00", "-04:00"].
+function splitTime(text) {
+  const m = /^(\d{4}-\d{2}-\d{2}T\d{2}:\d{2}(?::\d{2}(?:\.\d+)?)?)(Z|[+-]\d{2}:?\d{2})$/i.exec(text || "");
+  return m ? [m[1], m[2].toUpperCase()] : null;
+}
+
+// Sets the form's inputs from a request body (a render's or a timelapse's,
+// canonical or as written); fields the form has no input for stay in the
+// JSON editor, which gets the whole body.
+function fillForm(body) {
+  const what = kindOfBody(body);
+  form.elements.kind.value = what;
+  const set = (id, value) => { $(id).value = value === null || value === undefined ? "" : String(value); };
+  const l = body.location || {};
+  set("#latitude", l.latitude_deg ?? 0);
+  set("#longitude", l.longitude_deg ?? 0);
+  set("#altitude", l.altitude_m ?? 0);
+  const first = splitTime(what === "render" ? body.time : body.start);
+  if (first) { set("#time-local", first[0]); set("#time-zone", first[1]); }
+  if (what === "timelapse") {
+    const end = splitTime(body.end);
+    if (end) set("#time-end", end[0]);
+    const byFrames = isNumber(body.frames);
+    set("#split-kind", byFrames ? "frames" : "step_s");
+    set("#split-value", byFrames ? body.frames : body.step_s);
+  }
+  const c = body.camera || {};
+  set("#projection", c.projection || "equirectangular");
+  set("#width", c.width ?? "");
+  set("#height", c.height ?? "");
+  set("#yaw", c.yaw_deg ?? 0);
+  set("#pitch", c.pitch_deg ?? 0);
+  set("#fov", c.projection && c.projection !== "equirectangular" ? c.fov_deg ?? "" : "");
+  const material = body.atmosphere?.ground?.material;
+  const known = material?.name && [...$("#ground-material").options].some((o) => o.value === material.name);
+  set("#ground-material", known ? material.name : "");
+  const roughness = material?.roughness;
+  set("#ground-roughness", Array.isArray(roughness) ? roughness[0] : roughness ?? "");
+  const balls = body.objects || [];
+  $("#reference-balls").checked = balls.length === 3 && balls.every((o, i) => o.name === ["chrome ball", "grey ball", "white ball"][i]);
+  const layer = body.clouds?.layers?.[0];
+  set("#cloud-type", layer?.type && layer.type !== "custom" ? layer.type : "");
+  if (layer) set("#cloud-coverage", layer.coverage ?? 0.4);
+  const wind = layer?.wind_m_s || null;
+  const speed = wind ? Math.hypot(wind[0], wind[1]) : layer?.wind?.speed_m_s;
+  set("#cloud-wind-speed", speed > 0 ? +speed.toFixed(3) : "");
+  // A wind from azimuth phi blows towards phi + 180 (api/cloud_fields.cpp).
+  const from = wind ? (Math.atan2(-wind[0], -wind[1]) * 180 / Math.PI + 360) % 360 : layer?.wind?.from_deg;
+  set("#cloud-wind-from", speed > 0 ? +from.toFixed(1) : 270);
+  set("#method", body.method || "path");
+  const q = body.quality || {};
+  const uncapped = q.samples_per_pixel >= kUncappedSamples && (isNumber(q.target_relative_error) || isNumber(q.time_limit_s));
+  set("#spp", uncapped ? "" : q.samples_per_pixel ?? "");
+  set("#target-error", q.target_relative_error ?? "");
+  set("#time-limit", q.time_limit_s ?? "");
+  $("#adaptive").checked = q.adaptive === true;
+  set("#name", body.name ?? "");
+  $("#request-json").value = JSON.stringify(body, null, 2);
+  $("#json-editor").open = true;
+  clearErrors();
+  updateFormMode();
+}
+
+function duplicate(body) {
+  if (!body) return;
+  fillForm(body);
+  $("#new").scrollIntoView({ block: "start" });
+  $("#name").focus({ preventScroll: true });
+}
+
+$("#json-from-form").addEventListener("click", () => {
+  clearErrors();
+  try { $("#request-json").value = JSON.stringify(readRequest(), null, 2); } catch (error) {
+    if (!error.input) throw error;
+    markInvalid(error.input, error.message);
+  }
+});
+
+$("#json-submit").addEventListener("click", async () => {
+  clearErrors();
+  let body;
+  try { body = JSON.parse($("#request-json").value); } catch (error) {
+    showProblem({ title: "The JSON cannot be read", detail: String(error.message || error) }, 0);
+    return;
+  }
+  await submitBody(kindOfBody(body), body, $("#json-submit"));
+});
 
 function updateFormMode() {
   document.body.dataset.kind = kind();
@@ -472,6 +634,9 @@ function showRender(id) {
   $("#timelapse").hidden = true;
   $("#job").hidden = false;
   $("#job-id").textContent = id;
+  $("#job-name").textContent = "Render";
+  $("#job-request").textContent = "";
+  $("#job-duplicate").disabled = $("#job-resubmit").disabled = true;
   $("#job-image").removeAttribute("src");
   $("#job-image-note").textContent = "Waiting for the first pass.";
   const base = `/v1/renders/${encodeURIComponent(id)}`;
@@ -526,15 +691,20 @@ function drawStatus(status) {
   $("#job-state").textContent = status.state;
   $("#job-state").dataset.state = status.state;
   const rms = status.error?.estimated_relative_rms;
+  $("#job-name").textContent = titleOf(status);
   $("#job-summary").textContent = [
     isNumber(p.fraction) ? percent(p.fraction) : "",
-    isNumber(p.samples_per_pixel) ? `${p.samples_per_pixel} spp` : "",
+    samplesText(p, status.request),
     isNumber(rms) ? `error ≈ ${percent(rms, 1)}` : "",
     isNumber(status.elapsed_s) ? `${seconds(status.elapsed_s)} elapsed` : "",
     isNumber(status.eta_s) ? `about ${seconds(status.eta_s)} left` : "",
   ].filter(Boolean).join(" · ");
   $("#job-progress").value = isNumber(p.fraction) ? p.fraction : 0;
   $("#job-cancel").disabled = kTerminal.has(status.state);
+  const body = requestOf(status);
+  const text = body ? JSON.stringify(body, null, 2) : "";
+  if ($("#job-request").textContent !== text) $("#job-request").textContent = text;
+  $("#job-duplicate").disabled = $("#job-resubmit").disabled = !body;
   drawDetails(status);
   drawErrorPlot($("#job-plot"), status.error?.history || [], status.method === "lut");
 }
@@ -542,8 +712,12 @@ function drawStatus(status) {
 function drawDetails(status) {
   const p = status.progress || {};
   const rows = [
+    ["Name", status.name],
+    ["Place", placeText(status.request)],
+    ["Time", timeText(status.request)],
+    ["Camera", cameraText(status.request)],
     ["Method", status.approximate ? `${status.method} (approximate)` : status.method],
-    ["Units", `${p.units_done ?? "–"} of ${p.units_total ?? "–"}`],
+    ["Samples", samplesText(p, status.request)],
     ["Stopped by", status.stopped_by],
     ["Plan", status.plan ? `${status.plan.tiles} tiles × ${status.plan.batches} batches × ${status.plan.passes} passes; ` +
       `media ${(status.plan.constituents || []).join(", ") || "none"}` : null],
@@ -654,6 +828,12 @@ function drawErrorPlot(plot, history, lut) {
     (points.length > 1 ? `, ${percent(el, 2)} at ${seconds(tl)} (${points.length} points)` : "");
 }
 
+$("#job-duplicate").addEventListener("click", () => duplicate(requestOf(view.status)));
+$("#job-resubmit").addEventListener("click", () => {
+  const body = requestOf(view.status);
+  if (body) submitBody("render", body, $("#job-resubmit"));
+});
+
 $("#job-cancel").addEventListener("click", async () => {
   if (!view.id) return;
   const res = await api(`/v1/renders/${encodeURIComponent(view.id)}`, { method: "DELETE" });
@@ -683,6 +863,9 @@ function showTimelapse(id) {
   view.id = null;
   $("#timelapse").hidden = false;
   $("#tl-id").textContent = id;
+  $("#tl-name").textContent = "Timelapse";
+  $("#tl-request").textContent = "";
+  $("#tl-duplicate").disabled = $("#tl-resubmit").disabled = true;
   $("#tl-strip").replaceChildren();
   $("#tl-frame").removeAttribute("src");
   $("#tl-frame-caption").textContent = "No frame finished yet.";
@@ -725,6 +908,11 @@ function drawTimelapse(status) {
   $("#tl-live").textContent = kTerminal.has(status.state) ? `Timelapse ${status.state}.`
     : `Timelapse ${status.state}, ${p.frames_done ?? 0} of ${p.frames_total ?? "?"} frames.`;
   $("#tl-cancel").disabled = kTerminal.has(status.state);
+  $("#tl-name").textContent = status.name || "Timelapse";
+  const body = requestOf(status);
+  const text = body ? JSON.stringify(body, null, 2) : "";
+  if ($("#tl-request").textContent !== text) $("#tl-request").textContent = text;
+  $("#tl-duplicate").disabled = $("#tl-resubmit").disabled = !body;
   drawFiles(status);
   const frames = status.frames || [];
   $("#tl-seek").max = String(Math.max(0, frames.length - 1));
@@ -848,6 +1036,11 @@ function pause() {
 }
 
 $("#tl-play").addEventListener("click", () => (lapse.player ? pause() : play()));
+$("#tl-duplicate").addEventListener("click", () => duplicate(requestOf(lapse.status)));
+$("#tl-resubmit").addEventListener("click", () => {
+  const body = requestOf(lapse.status);
+  if (body) submitBody("timelapse", body, $("#tl-resubmit"));
+});
 $("#tl-seek").addEventListener("input", () => { pause(); showFrame(+$("#tl-seek").value); });
 $("#tl-cancel").addEventListener("click", async () => {
   if (!lapse.id) return;
@@ -869,55 +1062,129 @@ function cancelButton(label, path) {
   return button;
 }
 
+// The state filter: "" shows every state.
+const stateShown = (state) => !$("#state-filter").value || $("#state-filter").value === state;
+
+// The list's title cell: name (or a short description), then place, time,
+// method and camera on a line of their own, and the id.
+// Renders have a thumbnail before the text.
+function titleCell(kindName, item) {
+  const open = element("a", { href: `#${kindName}=${item.id}`, className: "job-link" });
+  const text = element("div", { className: "title-text" }, [open, element("span", { className: "job-meta" }),
+    element("code", { className: "job-id", textContent: shortId(item.id), title: item.id })]);
+  const thumb = kindName === "render" ? [element("img", { className: "list-thumb", alt: "" })] : [];
+  return element("th", { scope: "row" }, element("div", { className: "title-box" }, [...thumb, text]));
+}
+
+function updateTitleCell(cell, kindName, item) {
+  const link = cell.querySelector("a");
+  const title = titleOf(item);
+  if (link.textContent !== title) link.textContent = title;
+  link.setAttribute("aria-label", `Show ${kindName} ${title} (${item.id})`);
+  link.classList.toggle("unnamed", !item.name);
+  const meta = [placeText(item.request), timeText(item.request), item.method, cameraText(item.request)]
+    .filter(Boolean).join(" · ");
+  const line = cell.querySelector(".job-meta");
+  if (line.textContent !== meta) line.textContent = meta;
+}
+
+// Thumbnails of done renders: each fetched once (the final image does not
+// change), a few at a time, kept as object URLs by id.
+const thumbnails = new Map();  // id -> object URL, or null while fetching
+function loadThumbnail(row, id) {
+  const img = row.querySelector("img.list-thumb");
+  const url = thumbnails.get(id);
+  if (url) { if (img.getAttribute("src") !== url) img.src = url; return; }
+  if (thumbnails.has(id) || [...thumbnails.values()].filter((v) => v === null).length >= kThumbnailFetches) return;
+  thumbnails.set(id, null);
+  fetchBlobUrl(`/v1/renders/${encodeURIComponent(id)}/image.png?width=${kListThumbnailWidth}`).then((blob) => {
+    if (!blob.url) { thumbnails.delete(id); return; }
+    thumbnails.set(id, blob.url);
+    const shown = $(`#jobs-body tr[data-key="${CSS.escape(id)}"] img.list-thumb`);
+    if (shown) shown.src = blob.url;
+  });
+}
+
 function drawRenders(list) {
   syncRows($("#jobs-body"), list, (job) => job.id, (job) => {
-    const open = element("a", { href: `#render=${job.id}`, className: "job-link", textContent: shortId(job.id), title: job.id });
-    open.setAttribute("aria-label", `Show render ${job.id}`);
     const bar = element("progress", { max: 1 });
     bar.setAttribute("aria-label", `Progress of render ${job.id}`);
-    const row = element("tr", {}, [element("th", { scope: "row" }, open), element("td"),
-      element("td", {}, [bar, element("span")]), element("td"), element("td"),
-      element("td", {}, cancelButton(`Cancel render ${job.id}`, `/v1/renders/${encodeURIComponent(job.id)}`))]);
+    const row = element("tr", {}, [titleCell("render", job),
+      element("td"), element("td", {}, [bar, element("span", { className: "progress-text" })]), element("td"),
+      element("td"), element("td", {}, cancelButton(`Cancel render ${job.id}`, `/v1/renders/${encodeURIComponent(job.id)}`))]);
     row.dataset.jobId = job.id;
     return row;
   }, (row, job) => {
     const fraction = job.progress?.fraction ?? 0;
     const rms = job.error?.estimated_relative_rms;
+    updateTitleCell(row.cells[0], "render", job);
     row.cells[1].textContent = job.state;
     row.cells[1].dataset.state = job.state;
+    row.dataset.state = job.state;
     row.cells[2].querySelector("progress").value = fraction;
-    row.cells[2].querySelector("span").textContent = ` ${percent(fraction)}`;
+    row.cells[2].querySelector("span").textContent = ` ${samplesText(job.progress, job.request) || percent(fraction)}`;
     row.cells[3].textContent = isNumber(rms) ? percent(rms, 1) : job.approximate ? "approximate" : "–";
     row.cells[4].textContent = job.created_unix ? new Date(job.created_unix * 1000).toLocaleString() : "";
     row.cells[5].querySelector("button").disabled = kTerminal.has(job.state);
     row.classList.toggle("selected", job.id === view.id);
+    row.hidden = !stateShown(job.state);
+    if (job.state === "done" && !job.expired) loadThumbnail(row, job.id);
   });
-  $("#jobs-note").textContent = list.length ? "" : "No renders yet.";
+  const shown = list.filter((job) => stateShown(job.state)).length;
+  $("#jobs-note").textContent = list.length === 0 ? "No renders yet." :
+    shown === 0 ? `None of the ${list.length} latest renders is ${$("#state-filter").value}.` : "";
 }
 
 function drawTimelapses(list) {
   syncRows($("#timelapses-body"), list, (t) => t.id, (t) => {
-    const open = element("a", { href: `#timelapse=${t.id}`, textContent: shortId(t.id), title: t.id });
-    open.setAttribute("aria-label", `Show timelapse ${t.id}`);
-    const row = element("tr", {}, [element("th", { scope: "row" }, open), element("td"), element("td"),
+    const row = element("tr", {}, [titleCell("timelapse", t), element("td"), element("td"), element("td"),
       element("td", {}, cancelButton(`Cancel timelapse ${t.id}`, `/v1/timelapses/${encodeURIComponent(t.id)}`))]);
     return row;
   }, (row, t) => {
+    updateTitleCell(row.cells[0], "timelapse", t);
     row.cells[1].textContent = t.state;
     row.cells[1].dataset.state = t.state;
+    row.dataset.state = t.state;
     row.cells[2].textContent = `${t.progress?.frames_done ?? 0} of ${t.progress?.frames_total ?? "?"}`;
-    row.cells[3].querySelector("button").disabled = kTerminal.has(t.state);
+    row.cells[3].textContent = t.created_unix ? new Date(t.created_unix * 1000).toLocaleString() : "";
+    row.cells[4].querySelector("button").disabled = kTerminal.has(t.state);
+    row.classList.toggle("selected", t.id === lapse.id);
+    row.hidden = !stateShown(t.state);
   });
+}
+
+// Drain: the server sends the worker no new units (those in flight finish);
+// Resume undoes it.
+function drainButton() {
+  const button = element("button", { type: "button", className: "secondary drain" });
+  button.addEventListener("click", async () => {
+    const id = button.closest("tr").dataset.key;
+    const action = button.dataset.action;
+    button.disabled = true;
+    const res = await api(`/v1/workers/${encodeURIComponent(id)}/${action}`, { method: "POST" });
+    if (!res.ok) $("#workers-note").textContent = res.data?.detail || `HTTP ${res.status}`;
+    await refreshLists();
+    button.disabled = false;
+  });
+  return button;
 }
 
 function drawWorkers(list) {
   syncRows($("#workers-body"), list, (w) => w.id, () => element("tr", {}, [element("th", { scope: "row" }),
-    element("td"), element("td"), element("td"), element("td")]), (row, w) => {
+    element("td"), element("td"), element("td"), element("td"), element("td", {}, [element("span"), drainButton()])]),
+  (row, w) => {
     row.cells[0].textContent = w.id;
     row.cells[1].textContent = w.cores ?? "–";
     row.cells[2].textContent = w.units_in_flight ?? "–";
     row.cells[3].textContent = w.units_done ?? "–";
     row.cells[4].textContent = isNumber(w.last_seen_s) ? `${seconds(w.last_seen_s)} ago` : "–";
+    const draining = w.draining === true;
+    row.dataset.draining = String(draining);
+    row.cells[5].querySelector("span").textContent = draining ? "draining " : "";
+    const button = row.cells[5].querySelector("button");
+    button.dataset.action = draining ? "resume" : "drain";
+    button.textContent = draining ? "Resume" : "Drain";
+    button.setAttribute("aria-label", `${draining ? "Resume" : "Drain"} worker ${w.id}`);
   });
   $("#workers-note").textContent = list.length ? "" : "No worker is connected: renders wait in the queue.";
 }
@@ -960,6 +1227,10 @@ function showFromHash() {
   $(m[1] === "render" ? "#job" : "#timelapse").scrollIntoView({ block: "nearest" });
 }
 
+$("#state-filter").addEventListener("change", () => {
+  for (const row of document.querySelectorAll("#jobs-body tr, #timelapses-body tr")) row.hidden = !stateShown(row.dataset.state);
+  refreshLists();
+});
 window.addEventListener("hashchange", showFromHash);
 updateFormMode();
 refreshLists();

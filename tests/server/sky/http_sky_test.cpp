@@ -216,8 +216,14 @@ TEST_F(SkyHttpTest, BadParametersAre400NamingTheParameter) {
   expect_bad("/v1/sky/envmap.exr?" + sun + "&width=101", "width");  // odd
   expect_bad("/v1/sky/envmap.exr?" + sun + "&width=4", "width");
   expect_bad("/v1/sky/envmap.exr?" + sun + "&sun=bright", "sun");
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&color_space=srgb", "color_space");
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&units=nits", "units");
+  expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&color_space=acescg", "color_space");  // envmap only
   expect_bad("/v1/sky/envmap.exr?" + sun + "&altitude=200000&width=2048", "width");  // a ray march per pixel
   expect_bad("/v1/sky/envmap.exr?" + sun + "&view_zenith=0", "view_zenith");  // lookup only
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=cube", "layout");
+  expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=equal_area&width=8192", "width");  // 4096 at most
+  expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&layout=equal_area", "layout");  // envmap only
   // Every error at once, each by its name.
   auto r = client().Get("/v1/sky?lat=95&view_azimuth=400&foo=1");
   ASSERT_TRUE(r);
@@ -334,6 +340,62 @@ TEST_F(SkyHttpTest, EnvmapPixelsAgreeWithLookupsAlongTheirDirections) {
   EXPECT_EQ(service_->stats().table_builds, 1u) << "the map and the look-ups share the table";
 }
 
+TEST_F(SkyHttpTest, EqualAreaEnvmapIsSquareWithTheZenithAtTheCentre) {
+  start();
+  auto c = client();
+  // The default layout's canonical request has no `layout` key (older maps keep their bytes).
+  auto latlong = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none");
+  ASSERT_TRUE(latlong);
+  ASSERT_EQ(latlong->status, 200);
+  const auto latlong_request =
+      nlohmann::json::parse(read_exr_bytes(latlong->body).string_attributes.at("skyfarm:request"));
+  EXPECT_FALSE(latlong_request.contains("layout"));
+  auto same = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&sun=none&layout=latlong");
+  ASSERT_TRUE(same);
+  EXPECT_TRUE(same->body == latlong->body) << "layout=latlong is the default, byte for byte";
+
+  auto r = c.Get("/v1/sky/envmap.exr?sun_zenith=60&sun_azimuth=90&width=64&layout=equal_area");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  const ExrFile exr = read_exr_bytes(r->body);
+  EXPECT_EQ(exr.width, 64);
+  EXPECT_EQ(exr.height, 64);
+  EXPECT_EQ(exr.string_attributes.at("skyfarm:layout").rfind("equal_area", 0), 0u);
+  EXPECT_EQ(nlohmann::json::parse(exr.string_attributes.at("skyfarm:request"))["layout"], "equal_area");
+  EXPECT_EQ(r->body.find("envmap"), std::string::npos) << "no LATLONG envmap attribute";
+  // The brightest pixel is the sun's: east of the zenith (right of the
+  // centre), on the centre row; zenith 60 deg -> r = sqrt(1 - cos 60) = 0.707
+  // of the half width: x = 32 + 0.707 x 32 = 54.6.
+  const auto& R = exr.channels.at("R").values;
+  const auto& G = exr.channels.at("G").values;
+  const auto& B = exr.channels.at("B").values;
+  std::size_t best = 0;
+  double best_y = -1;
+  for (std::size_t i = 0; i < R.size(); ++i) {
+    const double y = 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+    if (y > best_y) best_y = y, best = i;
+  }
+  EXPECT_NEAR(static_cast<int>(best % 64), 54, 1);
+  EXPECT_NEAR(static_cast<int>(best / 64), 32, 1);
+  // The four pixels around the centre surround the zenith, the four corners
+  // the nadir: their means are the look-ups there within 3 % (each pixel
+  // averages ~3 deg of a smooth sky; the ground near the nadir is uniform).
+  auto Y = [&](int x, int y) {
+    const std::size_t i = static_cast<std::size_t>(y) * 64 + static_cast<std::size_t>(x);
+    return 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+  };
+  auto lookup = [&](const char* view) {
+    auto look = c.Get(std::string("/v1/sky?sun_zenith=60&sun_azimuth=90&") + view);
+    EXPECT_TRUE(look && look->status == 200);
+    return look ? json_of(look)["luminance_cd_m2"].get<double>() : 0.0;
+  };
+  const double zenith = lookup("view_zenith=0&view_azimuth=0");
+  const double nadir = lookup("view_zenith=180&view_azimuth=0");
+  EXPECT_NEAR((Y(31, 31) + Y(32, 31) + Y(31, 32) + Y(32, 32)) / 4, zenith, 0.03 * zenith);
+  for (auto [x, y] : {std::pair{0, 0}, std::pair{63, 0}, std::pair{0, 63}, std::pair{63, 63}})
+    EXPECT_NEAR(Y(x, y), nadir, 0.03 * nadir) << x << "," << y;
+}
+
 TEST_F(SkyHttpTest, MetricsIncludeTheCacheCounters) {
   start();
   auto c = client();
@@ -414,6 +476,74 @@ TEST(SkyQuery, DefaultsAndCanonicalForm) {
   ASSERT_TRUE(tokyo.time);
   EXPECT_EQ(tokyo.time->to_iso8601(), "2021-08-01T08:30:00Z");
   EXPECT_NEAR(tokyo.table.sun_zenith_deg, 76.2, 0.5);
+}
+
+// color_space and units: the defaults stay out of the canonical parameters
+// (the maps of before keep their cache key and ETag); others are in them.
+TEST(SkyQuery, ColorSpaceAndUnitsAreInTheKeyOnlyWhenAsked) {
+  const SkyQuery plain = parse_sky_query({{"sun_zenith", "45"}, {"sun_azimuth", "0"}}, SkyRoute::kEnvmap);
+  const SkyQuery defaults = parse_sky_query(
+      {{"sun_zenith", "45"}, {"sun_azimuth", "0"}, {"color_space", "lin_rec709"}, {"units", "cd_m2"}},
+      SkyRoute::kEnvmap);
+  EXPECT_EQ(plain.canonical_json(SkyRoute::kEnvmap), defaults.canonical_json(SkyRoute::kEnvmap));
+  EXPECT_FALSE(plain.canonical_json(SkyRoute::kEnvmap).contains("color_space"));
+  const SkyQuery aces = parse_sky_query(
+      {{"sun_zenith", "45"}, {"sun_azimuth", "0"}, {"color_space", "aces2065-1"}, {"units", "relative"}},
+      SkyRoute::kEnvmap);
+  EXPECT_EQ(aces.color_space, ColorSpace::kAces2065_1);
+  EXPECT_EQ(aces.units, RadiometricUnits::kRelative);
+  EXPECT_EQ(aces.canonical_json(SkyRoute::kEnvmap)["color_space"], "aces2065-1");
+  EXPECT_EQ(aces.canonical_json(SkyRoute::kEnvmap)["units"], "relative");
+}
+
+// The sun at the horizon (zenith 89.5 degrees) is red enough to be outside
+// Rec.709: its pixel has a negative blue channel in the default map.  In
+// ACES2065-1 (AP0 encloses the spectral locus) no pixel of the map, the
+// sun's included, is negative, and the file says which primaries it holds
+// (SMPTE ST 2065-1 AP0); converted back, the sun's pixel is the Rec.709 one
+// (to 1e-4 of its luminance).
+TEST_F(SkyHttpTest, EnvmapOfTheHorizonSunInAces2065HasNoNegativeChannel) {
+  start();
+  auto c = client();
+  const std::string base = "/v1/sky/envmap.exr?sun_zenith=89.5&sun_azimuth=270&width=128&lat=45";
+  auto rec709 = c.Get(base);
+  auto ap0 = c.Get(base + "&color_space=aces2065-1");
+  ASSERT_TRUE(rec709 && ap0);
+  ASSERT_EQ(rec709->status, 200) << rec709->body;
+  ASSERT_EQ(ap0->status, 200) << ap0->body;
+  const ExrFile a = read_exr_bytes(rec709->body), b = read_exr_bytes(ap0->body);
+  const auto &R = a.channels.at("R").values, &G = a.channels.at("G").values, &B = a.channels.at("B").values;
+  std::size_t sun = 0;
+  double best = -1;
+  for (std::size_t i = 0; i < R.size(); ++i) {
+    const double y = 0.2126 * R[i] + 0.7152 * G[i] + 0.0722 * B[i];
+    if (y > best) best = y, sun = i;
+  }
+  EXPECT_NEAR(static_cast<double>(sun % 128), 32.0, 1.5) << "west, a quarter turn left of north";
+  EXPECT_LT(B[sun], 0.0) << "the red sun is outside Rec.709: R " << R[sun] << " G " << G[sun];
+  const auto &R0 = b.channels.at("R").values, &G0 = b.channels.at("G").values, &B0 = b.channels.at("B").values;
+  float lowest = 0.0f;
+  for (std::size_t i = 0; i < R0.size(); ++i) lowest = std::min({lowest, R0[i], G0[i], B0[i]});
+  EXPECT_GE(lowest, 0.0f);
+  EXPECT_GT(R0[sun], G0[sun]);
+  EXPECT_GT(G0[sun], B0[sun]);
+  ASSERT_TRUE(b.chromaticities.has_value());
+  const auto& p = *b.chromaticities;
+  EXPECT_NEAR(p[0].x, 0.7347, 1e-7);
+  EXPECT_NEAR(p[0].y, 0.2653, 1e-7);
+  EXPECT_NEAR(p[1].x, 0.0, 1e-7);
+  EXPECT_NEAR(p[1].y, 1.0, 1e-7);
+  EXPECT_NEAR(p[2].x, 0.0001, 1e-7);
+  EXPECT_NEAR(p[2].y, -0.077, 1e-7);
+  EXPECT_NEAR(p[3].x, 0.32168, 1e-7);
+  EXPECT_NEAR(p[3].y, 0.33767, 1e-7);
+  EXPECT_EQ(b.string_attributes.at("skyfarm:color_space"), "aces2065-1");
+  float back[3] = {R0[sun], G0[sun], B0[sun]};
+  convert_color_space(ColorSpace::kAces2065_1, ColorSpace::kLinRec709, back, 1);
+  EXPECT_NEAR(back[0], R[sun], 1e-4 * best);
+  EXPECT_NEAR(back[1], G[sun], 1e-4 * best);
+  EXPECT_NEAR(back[2], B[sun], 1e-4 * best);
+  EXPECT_NE(a.string_attributes.at("skyfarm:request"), b.string_attributes.at("skyfarm:request"));
 }
 
 // POST /v1/sky/radiance: the probe by the LUT (no standard

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/camera/camera.h"
+#include "common/geometry/equal_area.h"
 #include "common/image/exr_writer.h"
 #include "common/lut/fibonacci_directions.h"
 #include "tests/support/coarse_lut.h"
@@ -297,6 +298,86 @@ TEST(SkyServiceEnvmap, SunPixelsAreBrightestAndTheDiskEnergyIsExact) {
     const SunDiskSummary disk = sun_disk_summary(*table);
     EXPECT_NEAR(energy, disk.illuminance_lux, 1e-3 * disk.illuminance_lux) << width;
     EXPECT_GT(disk.xyz.y, 1e8) << "the disk at 60 degrees is ~1e9 cd/m^2";
+  }
+}
+
+// Integrals of a map's luminance: over the sphere (the mean luminance times
+// 4 pi) and cosine-weighted over the upper hemisphere (the horizontal
+// illuminance, lux).  Lat-long pixels: the exact solid angle and cosine
+// integral of each latitude band; equal-area pixels: 4 pi / N^2 each, the
+// cosine taken at the pixel's 4 x 4 sub-centres.
+struct MapIntegrals {
+  double sphere = 0.0, horizontal = 0.0;
+};
+
+MapIntegrals latlong_integrals(const Image& image) {
+  MapIntegrals m;
+  const int w = image.width(), h = image.height();
+  for (int y = 0; y < h; ++y) {
+    const double t0 = M_PI * y / h, t1 = M_PI * (y + 1) / h;  // polar angle band
+    const double omega = 2.0 * M_PI / w * (std::cos(t0) - std::cos(t1));
+    // integral of cos(theta) sin(theta) dtheta over the band, upper hemisphere only
+    const double a = std::min(t0, M_PI / 2), b = std::min(t1, M_PI / 2);
+    const double cos_omega = 2.0 * M_PI / w * 0.5 * (std::sin(b) * std::sin(b) - std::sin(a) * std::sin(a));
+    for (int x = 0; x < w; ++x) {
+      m.sphere += image.luminance(x, y) * omega;
+      m.horizontal += image.luminance(x, y) * cos_omega;
+    }
+  }
+  return m;
+}
+
+MapIntegrals equal_area_integrals(const Image& image) {
+  MapIntegrals m;
+  const int n = image.width();
+  const double omega = equal_area_pixel_solid_angle(n);
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      double cosine = 0.0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = 0; j < 4; ++j)
+          cosine += std::max(0.0, equal_area_square_to_sphere({(x + (i + 0.5) / 4) / n, (y + (j + 0.5) / 4) / n}).z);
+      m.sphere += image.luminance(x, y) * omega;
+      m.horizontal += image.luminance(x, y) * omega * cosine / 16.0;
+    }
+  return m;
+}
+
+TEST(SkyServiceEnvmap, EqualAreaMapHoldsTheLatLongMapsFlux) {
+  // Two independent discretisations of one sky: their integrals agree to
+  // 0.5 %, the disk's energy is exact in both (1e-3, as above), and the
+  // sun's pixel is where equal_area_sphere_to_square puts its direction.
+  for (auto [zenith, azimuth] : {std::pair{60.0, 100.0}, std::pair{30.0, 215.0}}) {
+    const auto table = build_sky_table(params(zenith, azimuth));
+    // Pixels of ~0.4 deg: the disk's cosine weight is its pixel's (0.1 % of
+    // its illuminance at most), the sky's gradients are resolved.
+    constexpr int n = 512;
+    const Image latlong = render_envmap(*table, 2 * n, EnvmapSun::kDisk, 2);
+    const Image square = render_envmap_equal_area(*table, n, EnvmapSun::kDisk, 2);
+    const Image bare = render_envmap_equal_area(*table, n, EnvmapSun::kNone, 2);
+    ASSERT_EQ(square.width(), n);
+    ASSERT_EQ(square.height(), n);
+    const MapIntegrals a = latlong_integrals(latlong), b = equal_area_integrals(square);
+    EXPECT_NEAR(b.sphere, a.sphere, 5e-3 * a.sphere) << zenith;
+    EXPECT_NEAR(b.horizontal, a.horizontal, 5e-3 * a.horizontal) << zenith;
+    // The disk alone: its normal illuminance times cos(zenith) on the horizontal.
+    const SunDiskSummary disk = sun_disk_summary(*table);
+    const MapIntegrals sky = equal_area_integrals(bare);
+    EXPECT_NEAR(b.sphere - sky.sphere, disk.illuminance_lux, 1e-3 * disk.illuminance_lux) << zenith;
+    // The brightest pixel is the sun's.
+    const glm::dvec2 p = equal_area_sphere_to_square(table->sun.direction());
+    int bx = 0, by = 0;
+    double best = -1;
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        if (square.luminance(x, y) > best) best = square.luminance(x, y), bx = x, by = y;
+    EXPECT_LE(std::abs(bx - static_cast<int>(p.x * n)), 1) << zenith;
+    EXPECT_LE(std::abs(by - static_cast<int>(p.y * n)), 1) << zenith;
+    // ... and it lies in the sun's quadrant of the observer frame: the image
+    // is read as x east, y north (down), z zenith (the centre).
+    const double east = std::sin(azimuth * M_PI / 180.0), north = std::cos(azimuth * M_PI / 180.0);
+    EXPECT_EQ(bx > n / 2, east > 0) << zenith;
+    EXPECT_EQ(by > n / 2, north > 0) << zenith;
   }
 }
 

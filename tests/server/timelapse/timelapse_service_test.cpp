@@ -294,6 +294,43 @@ TEST(TimelapseService, ARestartedServiceShowsTheTimelapseAndFinishesIt) {
   EXPECT_EQ((*again.status(id))["state"], "done");
 }
 
+// A name labels the timelapse (status and list) and its frames' renders,
+// and survives a restart; the canonical request (its "request") has none.
+TEST(TimelapseService, ANameLabelsTheTimelapseAndItsFramesAcrossARestart) {
+  const fs::path dir = fresh_dir("name");
+  std::string id;
+  {
+    JobService jobs(dir);
+    TimelapseService timelapses(jobs, dir, test_options());
+    id = timelapses.submit(api::parse_timelapse_request(request_text(18, R"(, "name": "Ithaca evening")")), std::nullopt)
+             .id;
+    const nlohmann::json status = *timelapses.status(id);
+    EXPECT_EQ(status["name"], "Ithaca evening");
+    EXPECT_FALSE(status["request"].contains("name"));
+    EXPECT_EQ(timelapses.list(0, 10)[0]["name"], "Ithaca evening");
+    const std::string frame = status["frames"][1]["render_id"];
+    EXPECT_EQ((*jobs.status(frame))["name"], "Ithaca evening (frame 2 of 18)");
+    // Unnamed: null.  (Its frames differ from the named one's by their
+    // exposure: frames of equal requests would be one render, and the
+    // render keeps the name it was first given.)
+    const std::string other =
+        timelapses.submit(api::parse_timelapse_request(request_text(2, R"(, "output": {"exposure_ev": 12})")), std::nullopt)
+            .id;
+    EXPECT_TRUE((*timelapses.status(other))["name"].is_null());
+  }
+  JobService jobs(dir);
+  TimelapseService timelapses(jobs, dir, test_options());
+  EXPECT_EQ((*timelapses.status(id))["name"], "Ithaca evening");
+  // Frames submitted after the restart (beyond the first 16, submitted at
+  // once) are named too.
+  SimulatedWorker worker(jobs);
+  const nlohmann::json done = run_until_finished(timelapses, worker, id);
+  ASSERT_EQ(done["state"], "done") << done.dump(1);
+  for (const nlohmann::json& f : done["frames"])
+    EXPECT_EQ((*jobs.status(f["render_id"].get<std::string>()))["name"],
+              "Ithaca evening (frame " + std::to_string(f["index"].get<int>() + 1) + " of 18)");
+}
+
 TEST(TimelapseService, IdempotencyKeysAndTheResultCache) {
   const fs::path dir = fresh_dir("idem");
   JobService jobs(dir);
