@@ -210,6 +210,15 @@ TEST(ExrMetadata, EveryOutputWritesTheDocumentedVocabulary) {
                           metadata_key::kSunZenithDeg, metadata_key::kSunAzimuthDeg, metadata_key::kEarthSunDistanceAu,
                           metadata_key::kWavelengthMinNm, metadata_key::kWavelengthMaxNm})
     for (const auto& output : outputs) EXPECT_TRUE(written[output].count(key)) << output << " lacks " << key;
+  // Non-default colour output adds its documented keys, nothing undocumented.
+  std::string colour = kRequest;
+  colour.replace(colour.find(R"("seed")"), 0, R"("output": {"color_space": "acescg", "units": "relative"}, )");
+  const std::string colour_exr = testing::local_render_exr(colour, dir);
+  ASSERT_FALSE(colour_exr.empty());
+  const Written colour_keys = exr_keys(colour_exr, dir / "colour.exr");
+  check_against_doc("local", colour_keys, doc);
+  for (const char* key : {metadata_key::kColorSpace, metadata_key::kUnits, metadata_key::kUnitsScale})
+    EXPECT_TRUE(colour_keys.count(key)) << key;
   // The env map's deprecated alias sits next to the canonical name.
   EXPECT_EQ(written["envmap"].count(metadata_key::kSunEarthDistanceAuDeprecated), 1u);
 }
