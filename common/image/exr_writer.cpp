@@ -148,11 +148,12 @@ ExrWriteReport write_exr(const Image& image, const std::filesystem::path& path, 
       header.insert(name, Imf::DoubleAttribute(std::get<double>(value)));
   }
   if (options.color_space != ColorSpace::kLinRec709)
-    header.insert(std::string(kExrMetadataPrefix) + "color_space",
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kColorSpace,
                   Imf::StringAttribute(std::string(name_of(options.color_space))));
   if (options.units != RadiometricUnits::kCdM2) {
-    header.insert(std::string(kExrMetadataPrefix) + "units", Imf::StringAttribute(std::string(name_of(options.units))));
-    header.insert(std::string(kExrMetadataPrefix) + "units_scale", Imf::DoubleAttribute(units_factor));
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kUnits,
+                  Imf::StringAttribute(std::string(name_of(options.units))));
+    header.insert(std::string(kExrMetadataPrefix) + metadata_key::kUnitsScale, Imf::DoubleAttribute(units_factor));
   }
   if (options.half)
     header.insert(std::string(kExrMetadataPrefix) + metadata_key::kHalfClampedValues,
