@@ -112,12 +112,10 @@ inline constexpr const char kErrorChannel[] = "error.Y";               // the er
 inline constexpr const char kExposureEv100[] = "exposure_ev100";       // PNG only
 inline constexpr const char kExposureScale[] = "exposure_scale";       // PNG only
 // Colour management (color_management.h), each only when not the default:
-// written by the EXR writer for output.color_space / output.units, by the
-// PNG writer for output.view.
-inline constexpr const char kColorSpace[] = "color_space";
-inline constexpr const char kUnits[] = "units";
-inline constexpr const char kUnitsScale[] = "units_scale";
-inline constexpr const char kView[] = "view";                         // PNG only
+inline constexpr const char kColorSpace[] = "color_space";  // EXR: not lin_rec709
+inline constexpr const char kUnits[] = "units";              // EXR: not cd_m2
+inline constexpr const char kUnitsScale[] = "units_scale";   // EXR: with kUnits; cd/m² × it = the values
+inline constexpr const char kView[] = "view";                // PNG: not srgb
 }  // namespace metadata_key
 
 // Every key is written with this prefix: an EXR attribute "skyfarm:<key>",

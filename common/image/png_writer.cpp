@@ -229,8 +229,7 @@ PngWriteReport write_png(const Image& image, const std::filesystem::path& path, 
   entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureEv100, shortest(report.exposure_ev));
   entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kExposureScale, shortest(report.scale));
   // Only a non-default view is named: the default's bytes stay as they were.
-  if (options.view != DisplayView::kSrgb)
-    entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kView, std::string(name_of(options.view)));
+  if (options.view != DisplayView::kSrgb) entries.emplace_back(std::string(kMetadataPrefix) + metadata_key::kView, std::string(name_of(options.view)));
   write_png_rows(path, w, h, options.bit_depth, rows.data(), entries);
   return report;
 }

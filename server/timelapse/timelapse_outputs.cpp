@@ -32,8 +32,8 @@ Image load_frame(const fs::path& exr_path) {
   // A frame written in another colour space or other units (output.color_space,
   // output.units) back to linear Rec.709 in cd/m^2, what the PNG expects.
   const std::string prefix = kExrMetadataPrefix;
-  const std::string color_space_key = prefix + "color_space", units_key = prefix + "units",
-                    units_scale_key = prefix + "units_scale";
+  const std::string color_space_key = prefix + metadata_key::kColorSpace, units_key = prefix + metadata_key::kUnits,
+                    units_scale_key = prefix + metadata_key::kUnitsScale;
   if (const auto it = exr.string_attributes.find(color_space_key); it != exr.string_attributes.end()) {
     const std::optional<ColorSpace> space = color_space_named(it->second);
     if (!space) throw std::runtime_error(exr_path.string() + ": unknown colour space '" + it->second + "'");
