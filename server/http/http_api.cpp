@@ -95,6 +95,14 @@ std::optional<std::string_view> allowed_methods(std::string_view path) {
   if (path == "/v1/workers" || path == "/v1/openapi.yaml" || path == "/healthz" || path == "/metrics" ||
       path == "/v1/sky" || path == "/v1/sky/envmap.exr" || find_web_file(path))
     return "GET, HEAD";
+  constexpr std::string_view kWorkers = "/v1/workers/";
+  if (path.starts_with(kWorkers)) {  // /v1/workers/{id}/drain | resume
+    const std::string_view rest = path.substr(kWorkers.size());
+    const std::size_t slash = rest.find('/');
+    if (slash == 0 || slash == std::string_view::npos) return std::nullopt;
+    const std::string_view action = rest.substr(slash + 1);
+    return action == "drain" || action == "resume" ? std::optional<std::string_view>("POST") : std::nullopt;
+  }
   constexpr std::string_view kPrefix = "/v1/renders/";
   if (!path.starts_with(kPrefix)) return std::nullopt;
   const std::string_view rest = path.substr(kPrefix.size());
