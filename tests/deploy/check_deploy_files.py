@@ -35,15 +35,13 @@ import os
 import re
 import shlex
 import shutil
-import signal
-import socket
 import subprocess
 import sys
-import tempfile
-import time
 import urllib.request
 
 import yaml
+
+from idle_server import idle_server
 
 DEFAULT_UNIT_TIMEOUT_S = 120.0
 DATA_DIR = "/var/lib/skyfarm"
@@ -176,46 +174,16 @@ def seconds(value):
 
 # --- A running server: /healthz and the metric names of /metrics ----------
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def served_metrics(server_binary):
-    http, broker = free_port(), free_port()
-    env = {k: v for k, v in os.environ.items() if not k.startswith("SKYFARM_")}
-    with tempfile.TemporaryDirectory() as data:
-        proc = subprocess.Popen([server_binary, "--listen", f"127.0.0.1:{http}", "--broker",
-                                 f"tcp://127.0.0.1:{broker}", "--local-workers", "0", "--data-dir", data],
-                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env, cwd=data)
+    with idle_server(server_binary) as url:
+        with urllib.request.urlopen(url + "/healthz", timeout=2) as r:
+            if r.status != 200 or json.load(r).get("status") != "ok":
+                error("skyfarm-server", f"/healthz answered {r.status}")
         try:
-            deadline = time.monotonic() + 20
-            while True:
-                try:
-                    with urllib.request.urlopen(f"http://127.0.0.1:{http}/healthz", timeout=2) as r:
-                        if r.status != 200 or json.load(r).get("status") != "ok":
-                            error("skyfarm-server", f"/healthz answered {r.status}")
-                    break
-                except OSError:
-                    if proc.poll() is not None or time.monotonic() > deadline:
-                        sys.exit("skyfarm-server did not answer /healthz: " + proc.stdout.read().decode())
-                    time.sleep(0.1)
-            try:
-                with urllib.request.urlopen(f"http://127.0.0.1:{http}/metrics", timeout=5) as r:
-                    text = r.read().decode()
-            except (OSError, ValueError) as e:
-                time.sleep(0.2)
-                exited = proc.poll()
-                sys.exit(f"skyfarm-server gave no /metrics ({e})" +
-                         (f"; it exited with {exited}" if exited is not None else ""))
-        finally:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+            with urllib.request.urlopen(url + "/metrics", timeout=5) as r:
+                text = r.read().decode()
+        except (OSError, ValueError) as e:
+            sys.exit(f"skyfarm-server gave no /metrics ({e})")
     names = set()
     for line in text.splitlines():
         m = re.match(r"# TYPE (\S+)", line) or re.match(r"([a-zA-Z_:][a-zA-Z0-9_:]*)", line)

@@ -18,13 +18,10 @@ import argparse
 import json
 import os
 import re
-import signal
-import socket
-import subprocess
 import sys
-import tempfile
-import time
 import urllib.request
+
+from idle_server import idle_server
 
 errors = []
 
@@ -33,37 +30,11 @@ def error(text):
     errors.append(text)
 
 
-def free_port():
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
 def scrape(server_binary):
     """The /metrics text of a fresh server without workers."""
-    http, broker = free_port(), free_port()
-    env = {k: v for k, v in os.environ.items() if not k.startswith("SKYFARM_")}
-    with tempfile.TemporaryDirectory() as data:
-        proc = subprocess.Popen([server_binary, "--listen", f"127.0.0.1:{http}", "--broker",
-                                 f"tcp://127.0.0.1:{broker}", "--local-workers", "0", "--data-dir", data],
-                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, env=env, cwd=data)
-        try:
-            deadline = time.monotonic() + 20
-            while True:
-                try:
-                    with urllib.request.urlopen(f"http://127.0.0.1:{http}/metrics", timeout=5) as r:
-                        return r.read().decode()
-                except OSError:
-                    if proc.poll() is not None or time.monotonic() > deadline:
-                        sys.exit("skyfarm-server gave no /metrics: " + proc.stdout.read().decode())
-                    time.sleep(0.1)
-        finally:
-            proc.send_signal(signal.SIGTERM)
-            try:
-                proc.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
+    with idle_server(server_binary) as url:
+        with urllib.request.urlopen(url + "/metrics", timeout=5) as r:
+            return r.read().decode()
 
 
 def exported_names(text):
