@@ -85,6 +85,13 @@ EXR_MAGIC = b"\x76\x2f\x31\x01"   # OpenEXR file layout, "magic number": 2000063
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"  # PNG specification (ISO/IEC 15948), 5.2
 
 
+def scratch(test, prefix):
+    """A temporary folder removed after the test."""
+    folder = tempfile.mkdtemp(prefix=prefix)
+    test.addCleanup(shutil.rmtree, folder, True)
+    return folder
+
+
 def png_size(data):
     """(width, height) from a PNG's IHDR chunk, which must come first."""
     if data[:8] != PNG_SIGNATURE or data[12:16] != b"IHDR":

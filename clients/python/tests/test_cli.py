@@ -3,26 +3,17 @@ source tree, in a subprocess, against a real skyfarm-server."""
 
 import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import unittest
 
 sys.path.insert(0, os.path.dirname(__file__))
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 import skyfarm  # noqa: E402
-from farm_server import CLIENT_DIR, EXR_MAGIC, PNG_SIGNATURE, SOURCE_DIR, FarmServer, png_size  # noqa: E402
+from farm_server import CLIENT_DIR, EXR_MAGIC, PNG_SIGNATURE, SOURCE_DIR, FarmServer, png_size, scratch  # noqa: E402
 
 farm = None
-
-
-def scratch(test, prefix):
-    """A temporary folder removed after the test."""
-    folder = tempfile.mkdtemp(prefix=prefix)
-    test.addCleanup(shutil.rmtree, folder, True)
-    return folder
 
 
 def setUpModule():

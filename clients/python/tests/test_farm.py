@@ -6,25 +6,16 @@ the bearer token.  Tiny requests: the whole module runs in seconds."""
 import datetime
 import hashlib
 import os
-import shutil
 import sys
-import tempfile
 import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), ".."))
 
 import skyfarm  # noqa: E402
-from farm_server import EXR_MAGIC, PNG_SIGNATURE, SOURCE_DIR, FarmServer, png_size  # noqa: E402
+from farm_server import EXR_MAGIC, PNG_SIGNATURE, SOURCE_DIR, FarmServer, png_size, scratch  # noqa: E402
 
 farm = None
-
-
-def scratch(test, prefix):
-    """A temporary folder removed after the test."""
-    folder = tempfile.mkdtemp(prefix=prefix)
-    test.addCleanup(shutil.rmtree, folder, True)
-    return folder
 
 
 def setUpModule():
