@@ -1062,6 +1062,13 @@ function cancelButton(label, path) {
   return button;
 }
 
+// A finished job's Cancel button is disabled and out of sight (its cell keeps
+// its width, so the columns do not jump when a render ends).
+function setCancellable(button, cancellable) {
+  button.disabled = !cancellable;
+  button.style.visibility = cancellable ? "" : "hidden";
+}
+
 // The state filter: "" shows every state.
 const stateShown = (state) => !$("#state-filter").value || $("#state-filter").value === state;
 
@@ -1125,7 +1132,7 @@ function drawRenders(list) {
     row.cells[2].querySelector("span").textContent = ` ${samplesText(job.progress, job.request) || percent(fraction)}`;
     row.cells[3].textContent = isNumber(rms) ? percent(rms, 1) : job.approximate ? "approximate" : "–";
     row.cells[4].textContent = job.created_unix ? new Date(job.created_unix * 1000).toLocaleString() : "";
-    row.cells[5].querySelector("button").disabled = kTerminal.has(job.state);
+    setCancellable(row.cells[5].querySelector("button"), !kTerminal.has(job.state));
     row.classList.toggle("selected", job.id === view.id);
     row.hidden = !stateShown(job.state);
     if (job.state === "done" && !job.expired) loadThumbnail(row, job.id);
@@ -1147,7 +1154,7 @@ function drawTimelapses(list) {
     row.dataset.state = t.state;
     row.cells[2].textContent = `${t.progress?.frames_done ?? 0} of ${t.progress?.frames_total ?? "?"}`;
     row.cells[3].textContent = t.created_unix ? new Date(t.created_unix * 1000).toLocaleString() : "";
-    row.cells[4].querySelector("button").disabled = kTerminal.has(t.state);
+    setCancellable(row.cells[4].querySelector("button"), !kTerminal.has(t.state));
     row.classList.toggle("selected", t.id === lapse.id);
     row.hidden = !stateShown(t.state);
   });
