@@ -79,19 +79,22 @@ void expect_agree(const NaiveEstimate& a, const NaiveEstimate& b, const std::str
               (a.mean - b.mean) / std::hypot(a.standard_error, b.standard_error));
 }
 
-// The oracle's own quadrature against its analog walk limited to one order
-// (a check of the oracle: free flight and NEE against the integral).
+// The oracle's analog walk limited to one order against its own quadrature
+// (point sun): a check of the oracle's free flight, collision choice and NEE
+// against the integral they estimate, at sunset and in twilight.
 TEST(NaiveOracle, OracleWalkMatchesItsSingleScatteringQuadrature) {
-  const Scene scene = twilight_scene(93.0, 0.0);
-  const NaiveSkyEstimator naive(scene, 450.0);
-  const Ray ray = view_ray(scene, 85.0);
-  const double quadrature = naive.single_scattering(ray);
-  const NaiveEstimate walk = naive.estimate(ray, 20000, 11, 1);
-  std::printf("quadrature %.6e walk %.6e +- %.2e\n", quadrature, walk.mean, walk.standard_error);
-  ASSERT_GT(quadrature, 0.0);
-  EXPECT_NEAR(walk.mean, quadrature, 4.0 * walk.standard_error + kFloor * quadrature);
+  for (double sun_zenith : {90.0, 96.0}) {
+    const Scene scene = twilight_scene(sun_zenith, 0.0);
+    const NaiveSkyEstimator naive(scene, 650.0);
+    const Ray ray = view_ray(scene, 85.0);
+    NaiveEstimate quadrature;
+    quadrature.mean = naive.single_scattering(ray);
+    ASSERT_GT(quadrature.mean, 0.0);
+    const NaiveEstimate walk = naive.estimate(ray, 40000, 11, 1);
+    expect_agree(walk, quadrature, "oracle walk vs quadrature, sun " + std::to_string(sun_zenith));
+    EXPECT_LT(walk.standard_error, 0.1 * quadrature.mean);  // sharp enough to see a 40 % error
+  }
 }
-
 
 // The production estimator limited to one scattering event (max_depth 1),
 // point sun, against the deterministic single-scattering integral, with
@@ -104,7 +107,7 @@ TEST(NaiveOracle, SingleScatteringMatchesQuadrature) {
     bool explicit_single, sunlit_in_shadow;
   };
   const Variant variants[] = {{"default", false, true}, {"explicit", true, true}, {"no lit segments", false, false}};
-  for (double sun_zenith : {90.0, 96.0}) {
+  for (double sun_zenith : {90.0, 93.0, 96.0, 100.0}) {
     const Scene scene = twilight_scene(sun_zenith, 0.0);
     for (double lambda : {450.0, 650.0}) {
       const NaiveSkyEstimator naive(scene, lambda);
@@ -144,33 +147,41 @@ void compare_case(double sun_zenith, double lambda, double view_zenith, int prod
                    std::to_string(view_zenith));
 }
 
-// All orders, default options: the representative subset (twilight at
-// 96 deg, both wavelengths, zenith and towards the sun's horizon).
+// All orders, default options: the representative subset (sun 93 deg, both
+// wavelengths, zenith and towards the sun's horizon; 96 deg towards the
+// sun's horizon, where the oracle is still sharp enough at 50000 paths).
 TEST(NaiveOracle, AllOrdersAgreeAtTwilight) {
-  for (double lambda : {450.0, 650.0})
-    for (double view_zenith : {0.0, 85.0}) compare_case(96.0, lambda, view_zenith, 4000, 20000);
+  for (double lambda : {450.0, 650.0}) {
+    for (double view_zenith : {0.0, 85.0}) compare_case(93.0, lambda, view_zenith, 8000, 50000);
+    compare_case(96.0, lambda, 85.0, 8000, 50000);
+  }
 }
 
 // The whole table (sun 90, 93, 96, 100 deg x 450, 650 nm x zenith, horizon):
 // a manual run (--gtest_also_run_disabled_tests), its figures in the log.
+// Not at sun 100 deg, view zenith: there the lit air is reached only by
+// long multiple-scattering paths, and the oracle's 100000 paths score not
+// once (its estimate is 0; the production's 2.3e-7 at 450 nm).
 TEST(NaiveOracle, DISABLED_AllOrdersFullTable) {
   for (double sun_zenith : {90.0, 93.0, 96.0, 100.0})
     for (double lambda : {450.0, 650.0})
-      for (double view_zenith : {0.0, 85.0}) compare_case(sun_zenith, lambda, view_zenith, 20000, 100000);
+      for (double view_zenith : {0.0, 85.0})
+        if (sun_zenith < 100.0 || view_zenith > 0.0) compare_case(sun_zenith, lambda, view_zenith, 20000, 100000);
 }
 
 // Every IntegratorOptions setting that changes the estimator but not its
 // expectation, each toggled from the default, against one oracle estimate
-// at twilight (sun 96 deg, towards the sun's azimuth at 85 deg, 450 nm).
+// at twilight (sun 93 deg: the observer in the planet's shadow, so every
+// twilight device plays; towards the sun's azimuth at 85 deg, 450 nm).
 // Options without effect here: surface_sun_sampling and
 // surface_mis_heuristic (material grounds and objects only; the default
 // ground is Lambertian), cloud_sun_lobe (clouds only), max_depth (a cost cap,
 // not an unbiased device).
 TEST(NaiveOracle, EveryDeviceToggledAgreesWithTheOracle) {
-  const Scene scene = twilight_scene(96.0);
+  const Scene scene = twilight_scene(93.0);
   const double lambda = 450.0;
   const Ray ray = view_ray(scene, 85.0);
-  const NaiveEstimate n = NaiveSkyEstimator(scene, lambda).estimate(ray, 20000, 8);
+  const NaiveEstimate n = NaiveSkyEstimator(scene, lambda).estimate(ray, 100000, 8);
   struct Toggle {
     std::string name;
     IntegratorOptions options;
@@ -211,7 +222,7 @@ TEST(NaiveOracle, EveryDeviceToggledAgreesWithTheOracle) {
   std::uint64_t seed = 100;
   for (const Toggle& t : toggles) {
     PathCounters counters;
-    const NaiveEstimate p = production(scene, t.options, ray, lambda, 3000, ++seed, &counters);
+    const NaiveEstimate p = production(scene, t.options, ray, lambda, 4000, ++seed, &counters);
     EXPECT_EQ(counters.nonfinite, 0u) << t.name;
     expect_agree(p, n, t.name);
   }
