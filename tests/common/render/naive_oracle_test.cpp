@@ -116,12 +116,17 @@ TEST(NaiveOracle, SingleScatteringMatchesQuadrature) {
         NaiveEstimate q;
         q.mean = naive.single_scattering(ray);
         for (const Variant& v : variants) {
+          // Without the sunlit-segment estimator at 100 deg the lit air
+          // (above ~60 km along the view) is hardly ever reached by a
+          // collision: 0 of 8000 paths score; at 10^6 paths it agreed
+          // (z 0.87, SE 18 %; the experiment log).
+          if (sun_zenith >= 100.0 && !v.sunlit_in_shadow) continue;
           IntegratorOptions options;
           options.max_depth = 1;
           options.explicit_single_scattering = v.explicit_single;
           options.sunlit_segments_in_shadow = v.sunlit_in_shadow;
           PathCounters counters;
-          const NaiveEstimate p = production(scene, options, ray, lambda, 4000, 5, &counters);
+          const NaiveEstimate p = production(scene, options, ray, lambda, 8000, 5, &counters);
           EXPECT_EQ(counters.nonfinite, 0u);
           expect_agree(p, q,
                        "single sun " + std::to_string(sun_zenith) + " " + std::to_string(lambda) + " nm view " +
