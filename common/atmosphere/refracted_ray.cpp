@@ -111,4 +111,12 @@ RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer
   return out;
 }
 
+glm::dvec3 path_point(const RayVertex& vertex, const glm::dvec3& up, const glm::dvec3& forward) {
+  return vertex.radius_m * plane_direction(vertex.polar_angle_rad, up, forward);
+}
+
+glm::dvec3 plane_direction(double psi_rad, const glm::dvec3& up, const glm::dvec3& forward) {
+  return std::cos(psi_rad) * up + std::sin(psi_rad) * forward;
+}
+
 }  // namespace skyfarm

@@ -32,6 +32,8 @@
 
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "common/atmosphere/refractive_shells.h"
 
 namespace skyfarm {
@@ -53,5 +55,13 @@ struct RefractedRay {
 
 RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer_radius_m, double zenith_deg,
                                  bool record_path = true);
+
+// The ray's plane in planet-centred coordinates: up is the unit vector from the
+// centre to the observer, forward the unit horizontal direction of the ray at
+// the observer (perpendicular to up; any such vector for a vertical ray).
+glm::dvec3 path_point(const RayVertex& vertex, const glm::dvec3& up, const glm::dvec3& forward);
+// Unit direction at polar angle-plus-zenith psi (e.g. exit_direction_rad: the
+// escaped ray's direction, the true direction of the source it sees).
+glm::dvec3 plane_direction(double psi_rad, const glm::dvec3& up, const glm::dvec3& forward);
 
 }  // namespace skyfarm

@@ -40,6 +40,14 @@ TEST(RefractedRay, VacuumRaysAreStraight) {
     for (const auto& v : ray.path)
       EXPECT_NEAR(v.radius_m * std::sin(z * kDegToRad - v.polar_angle_rad), (kEarth + 500.0) * std::sin(z * kDegToRad),
                   1e-6);
+    // In 3D: every vertex on the line from the observer along the exit direction.
+    const glm::dvec3 up{0.0, 0.0, 1.0}, forward{1.0, 0.0, 0.0};
+    const glm::dvec3 o = (kEarth + 500.0) * up, d = plane_direction(ray.exit_direction_rad, up, forward);
+    for (const auto& v : ray.path) {
+      const glm::dvec3 q = path_point(v, up, forward) - o;
+      const glm::dvec3 off = q - (q.x * d.x + q.y * d.y + q.z * d.z) * d;
+      EXPECT_LT(std::sqrt(off.x * off.x + off.y * off.y + off.z * off.z), 1e-6);
+    }
   }
 }
 
