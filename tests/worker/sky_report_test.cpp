@@ -11,7 +11,8 @@ namespace {
 
 nlohmann::json apparent_sun(double zenith_deg, double altitude_m = 0.0) {
   const std::string body = R"({"sun": {"zenith_deg": )" + std::to_string(zenith_deg) +
-                           R"(, "azimuth_deg": 180}, "location": {"altitude_m": )" + std::to_string(altitude_m) + "}}";
+                           R"(, "azimuth_deg": 180}, "camera": {"projection": "fisheye"}, "location": {"altitude_m": )" +
+                           std::to_string(altitude_m) + "}}";
   return sky_report(api::parse_render_request(body))["apparent_sun"];
 }
 
@@ -33,7 +34,7 @@ TEST(SkyReportApparentSun, SunHalfADegreeBelowTheGeometricHorizonIsSeen) {
   // From 10 km the horizon dips by ~3 deg: the sun at true zenith 92 deg is seen.
   EXPECT_TRUE(apparent_sun(92.0, 10000.0)["visible"].get<bool>());
   const std::string text = format_sky_report(sky_report(api::parse_render_request(
-      std::string(R"({"sun": {"zenith_deg": 60, "azimuth_deg": 180}})"))));
+      std::string(R"({"sun": {"zenith_deg": 60, "azimuth_deg": 180}, "camera": {"projection": "fisheye"}})"))));
   EXPECT_NE(text.find("apparent sun"), std::string::npos);
 }
 

@@ -159,7 +159,9 @@ TEST(RefractedRay, LimbFromOrbitIsFiniteAndTwiceTheHorizonBending) {
       EXPECT_TRUE(std::isfinite(bending));
       EXPECT_LT(bending, previous_bending);
       previous_bending = bending;
-      if (tangent_km < 0.01) EXPECT_NEAR(bending, 2.0 * horizon, 0.05) << altitude;
+      if (tangent_km < 0.01) {
+        EXPECT_NEAR(bending, 2.0 * horizon, 0.05) << altitude;
+      }
     }
   }
 }
