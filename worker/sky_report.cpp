@@ -5,8 +5,11 @@
 #include <sstream>
 
 #include "common/atmosphere/atmosphere_builder.h"
+#include "common/atmosphere/refraction_table.h"
+#include "common/atmosphere/us76.h"
 #include "common/core/constants.h"
 #include "common/geometry/sphere_intersection.h"
+#include "common/sun/solar_position.h"
 #include "common/sun/sun.h"
 
 namespace skyfarm {
@@ -34,6 +37,37 @@ std::string scientific(double x) {
   return buf;
 }
 
+// Where the sun appears to the observer once the air bends its light: the
+// ray-traced refraction of US76 (common/atmosphere/refraction_table.h) at
+// 550 nm for the observer's altitude, next to the SPA's Bennett-based
+// correction at the same altitude's US76 pressure and temperature.  The
+// renderers still use the geometric position; this is a report.
+nlohmann::json apparent_sun_report(const Atmosphere& atmosphere, double geometric_zenith_deg, double altitude_m) {
+  constexpr double kWavelength_nm = 550.0;
+  RefractionTable::Options options;
+  options.wavelengths_nm = {kWavelength_nm};
+  options.planet_radius_m = atmosphere.planet_radius_m();
+  options.top_altitude_m = atmosphere.top_altitude_m();
+  const RefractionTable table(altitude_m, options);
+  const double geometric_elevation = 90.0 - geometric_zenith_deg;
+  const double h = std::max(0.0, altitude_m);
+  nlohmann::json a = {
+      {"wavelength_nm", kWavelength_nm},
+      {"model", "ray-traced US76, Ciddor refractive index"},
+      {"geometric_elevation_deg", geometric_elevation},
+      {"bennett_refraction_arcmin",
+       60.0 * refraction_correction_deg(geometric_elevation, us76::pressure_Pa(h) / 100.0,
+                                        us76::temperature_K(h) - 273.15)}};
+  const auto apparent = table.apparent_elevation_deg(geometric_elevation, kWavelength_nm);
+  a["visible"] = apparent.has_value();
+  if (apparent) {
+    a["apparent_elevation_deg"] = *apparent;
+    a["apparent_zenith_deg"] = 90.0 - *apparent;
+    a["refraction_arcmin"] = 60.0 * (*apparent - geometric_elevation);
+  }
+  return a;
+}
+
 }  // namespace
 
 nlohmann::json sky_report(const api::RenderRequest& request) {
@@ -49,6 +83,7 @@ nlohmann::json sky_report(const api::RenderRequest& request) {
               {"earth_sun_distance_au", sun.distance_au()},
               {"angular_radius_deg", request.sun.angular_radius_deg},
               {"source", (request.sun.zenith_deg ? "request" : "solar position algorithm")}};
+  r["apparent_sun"] = apparent_sun_report(atmosphere, sun.zenith_deg(), request.location.altitude_m);
 
   // Vertical optical depth of each constituent, ground to top.
   const auto wavelengths = report_wavelengths(request.spectral);
@@ -93,7 +128,16 @@ std::string format_sky_report(const nlohmann::json& r) {
   o << "sun               zenith " << fixed(s["zenith_deg"].get<double>(), 4) << " deg, azimuth "
     << fixed(s["azimuth_deg"].get<double>(), 4) << " deg (" << s["source"].get<std::string>() << ")\n";
   o << "                  Earth-Sun distance " << fixed(s["earth_sun_distance_au"].get<double>(), 6)
-    << " AU, disk radius " << s["angular_radius_deg"].get<double>() << " deg\n\n";
+    << " AU, disk radius " << s["angular_radius_deg"].get<double>() << " deg\n";
+  const auto& a = r["apparent_sun"];
+  if (a["visible"].get<bool>())
+    o << "apparent sun      elevation " << fixed(a["apparent_elevation_deg"].get<double>(), 4) << " deg, zenith "
+      << fixed(a["apparent_zenith_deg"].get<double>(), 4) << " deg: refraction "
+      << fixed(a["refraction_arcmin"].get<double>(), 2) << " arcmin at 550 nm (ray-traced US76; SPA/Bennett "
+      << fixed(a["bennett_refraction_arcmin"].get<double>(), 2) << ")\n";
+  else
+    o << "apparent sun      below the apparent horizon even with refraction (550 nm, ray-traced US76)\n";
+  o << "                  (a report only: renders use the geometric position)\n\n";
   o << "vertical optical depth, ground to top (" << r["top_altitude_m"].get<double>() / 1000.0 << " km)\n";
   o << "  constituent ";
   for (double l : r["wavelengths_nm"]) o << "  " << fixed(l, 1) << " nm";
