@@ -231,20 +231,8 @@ double NaiveSkyEstimator::sample(const Ray& camera, std::mt19937_64& rng, int ma
 }
 
 NaiveEstimate NaiveSkyEstimator::estimate(const Ray& ray, int paths, std::uint64_t seed, int max_order) const {
-  const auto start = std::chrono::steady_clock::now();
   std::mt19937_64 rng(seed);
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < paths; ++i) {
-    const double x = sample(ray, rng, max_order);
-    sum += x;
-    sum2 += x * x;
-  }
-  NaiveEstimate e;
-  e.paths = static_cast<std::uint64_t>(paths);
-  e.mean = sum / paths;
-  e.standard_error = std::sqrt(std::max(0.0, sum2 / paths - e.mean * e.mean) / (paths - 1.0));
-  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return e;
+  return estimate_mean(paths, [&](int) { return sample(ray, rng, max_order); });
 }
 
 // L1 = int_0^s_max T(0, s) sigma_s(s) p(mu) E T_sun(s) ds, by the midpoint

@@ -36,6 +36,9 @@
 // planet's shadow included, for a point sun (the disk's average over its
 // 0.27 deg is not integrated: use a scene with angular radius 0).
 #pragma once
+#include <algorithm>
+#include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <vector>
@@ -52,6 +55,24 @@ struct NaiveEstimate {
   std::uint64_t paths = 0;
   double seconds = 0.0;
 };
+
+// The mean of `paths` calls of sample(i), its standard error and the time taken.
+template <class Sample>
+NaiveEstimate estimate_mean(int paths, Sample&& sample) {
+  const auto start = std::chrono::steady_clock::now();
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < paths; ++i) {
+    const double x = sample(i);
+    sum += x;
+    sum2 += x * x;
+  }
+  NaiveEstimate e;
+  e.paths = static_cast<std::uint64_t>(paths);
+  e.mean = sum / paths;
+  e.standard_error = std::sqrt(std::max(0.0, sum2 / paths - e.mean * e.mean) / (paths - 1.0));
+  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return e;
+}
 
 class NaiveSkyEstimator {
  public:

@@ -50,24 +50,14 @@ Ray view_ray(const Scene& scene, double zenith_deg) {
 // spectral MIS is the identity) over `paths` paths.
 NaiveEstimate production(const Scene& scene, const IntegratorOptions& options, const Ray& ray, double lambda,
                          int paths, std::uint64_t seed, PathCounters* counters) {
-  const auto start = std::chrono::steady_clock::now();
   const VolumePathIntegrator integrator(scene, options);
   SampledWavelengths wl;
   wl.lambda_nm.fill(lambda);
   wl.pdf.fill(1.0);
-  double sum = 0.0, sum2 = 0.0;
-  for (int i = 0; i < paths; ++i) {
+  return testing::estimate_mean(paths, [&](int i) {
     Sampler sampler(seed, 0, static_cast<std::uint64_t>(i));
-    const double L = integrator.radiance(ray, wl, sampler, counters)[0];
-    sum += L;
-    sum2 += L * L;
-  }
-  NaiveEstimate e;
-  e.paths = static_cast<std::uint64_t>(paths);
-  e.mean = sum / paths;
-  e.standard_error = std::sqrt(std::max(0.0, sum2 / paths - e.mean * e.mean) / (paths - 1.0));
-  e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return e;
+    return integrator.radiance(ray, wl, sampler, counters)[0];
+  });
 }
 
 void expect_agree(const NaiveEstimate& a, const NaiveEstimate& b, const std::string& what) {
