@@ -15,21 +15,19 @@
 #include <string>
 #include <thread>
 
-#include "tests/farm/farm_process.h"
-#include "tests/support/webdriver.h"
+#include "tests/web/browser_farm_fixture.h"
 
 namespace skyfarm {
 namespace {
 
-namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using testing::FarmServer;
 using testing::WebDriver;
+using testing::js_string;
+using testing::kPageTimeout;
+using testing::kRenderTimeout;
+using testing::text_of;
 
-constexpr const char* kSkipMessage =
-    "headless Chromium not installed: scripts/install-deps.sh --browser (Debian packages chromium, chromium-driver)";
-constexpr auto kPageTimeout = 15s;  // deadlines only: each wait ends as soon as its condition holds
-constexpr auto kRenderTimeout = 60s;
 
 // A small named path-traced render over Ithaca (done in well under a second).
 constexpr const char* kNamed = R"({"name": "Alpha sunset over the lake",
@@ -43,32 +41,11 @@ constexpr const char* kCancelled = R"({"location": {"latitude_deg": 48.85, "long
   "camera": {"projection": "equirectangular", "width": 32, "height": 16},
   "quality": {"samples_per_pixel": 65536}})";
 
-std::string js_string(const std::string& text) { return nlohmann::json(text).dump(); }
-
-std::string text_of(WebDriver& driver, const std::string& css) {
-  return driver.execute("const e = document.querySelector(arguments[0]); return e ? e.textContent : null;", {css})
-      .get<std::string>();
-}
-
 std::string row_of(const std::string& id) { return js_string("#jobs-body tr[data-key=\"" + id + "\"]"); }
 
-class WebConsole : public ::testing::Test {
+class WebConsole : public testing::BrowserFarmTest {
  protected:
-  void SetUp() override {
-    const auto programs = WebDriver::find_programs();
-    if (!programs) GTEST_SKIP() << kSkipMessage;
-    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    server_.emplace(testing::fresh_dir("skyfarm_web_console", name) / "data", 1);
-    ASSERT_TRUE(server_->ok()) << server_->log();
-    driver_.emplace(*programs);
-    ASSERT_TRUE(driver_->ok()) << driver_->error();
-  }
-
-  void open_page() {
-    driver_->navigate("http://127.0.0.1:" + std::to_string(server_->port()) + "/");
-    ASSERT_TRUE(driver_->wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
-        << "app.js did not start\n" << driver_->log();
-  }
+  void SetUp() override { start("skyfarm_web_console"); }
 
   // Submits kNamed over HTTP and waits until it is done; its id.
   std::string named_render_done() {
@@ -77,9 +54,6 @@ class WebConsole : public ::testing::Test {
     EXPECT_EQ(server_->wait(id, kRenderTimeout)["state"], "done");
     return id;
   }
-
-  std::optional<FarmServer> server_;
-  std::optional<WebDriver> driver_;
 };
 
 TEST_F(WebConsole, ListShowsNamesFiltersByStateShowsTheRequestAndDuplicates) {

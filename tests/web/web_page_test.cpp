@@ -20,31 +20,18 @@
 #include <string>
 
 #include "server/timelapse/timelapse_video.h"
-#include "tests/farm/farm_process.h"
-#include "tests/support/webdriver.h"
+#include "tests/web/browser_farm_fixture.h"
 
 namespace skyfarm {
 namespace {
 
-namespace fs = std::filesystem;
 using namespace std::chrono_literals;
 using testing::FarmServer;
 using testing::WebDriver;
-
-constexpr const char* kSkipMessage =
-    "headless Chromium not installed: scripts/install-deps.sh --browser (Debian packages chromium, chromium-driver)";
-constexpr auto kPageTimeout = 15s;    // deadlines only: each wait ends as soon as its condition holds
-constexpr auto kRenderTimeout = 60s;
-
-fs::path fresh_dir(const std::string& name) {
-  const fs::path d = fs::temp_directory_path() / ("skyfarm_web_" + name + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-// A JavaScript string literal.
-std::string js_string(const std::string& text) { return nlohmann::json(text).dump(); }
+using testing::js_string;
+using testing::kPageTimeout;
+using testing::kRenderTimeout;
+using testing::text_of;
 
 // Sets a datetime-local input or a select the way its picker would (typing
 // into a datetime-local depends on the browser's locale), firing the events
@@ -56,31 +43,15 @@ void set_value(WebDriver& driver, const std::string& css, const std::string& val
                  {css, value});
 }
 
-std::string text_of(WebDriver& driver, const std::string& css) {
-  return driver.execute("const e = document.querySelector(arguments[0]); return e ? e.textContent : null;", {css})
-      .get<std::string>();
-}
-
-// Each test: a farm with one local worker (its own data folder) and headless
-// Chromium on the page, app.js started; skipped without Chromium.  The
-// browser goes before the server (members end in reverse order).
-class WebPage : public ::testing::Test {
+// Each test: a farm with one local worker and headless Chromium on the page,
+// app.js started (browser_farm_fixture.h); skipped without Chromium.
+class WebPage : public testing::BrowserFarmTest {
  protected:
   void SetUp() override {
-    const auto programs = WebDriver::find_programs();
-    if (!programs) GTEST_SKIP() << kSkipMessage;
-    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    server_.emplace(fresh_dir(name) / "data", 1);
-    ASSERT_TRUE(server_->ok()) << server_->log();
-    driver_.emplace(*programs);
-    ASSERT_TRUE(driver_->ok()) << driver_->error();
-    driver_->navigate("http://127.0.0.1:" + std::to_string(server_->port()) + "/");
-    ASSERT_TRUE(driver_->wait_until("return document.body.dataset.kind === 'render';", kPageTimeout))
-        << "app.js did not start\n" << driver_->log();
+    start("skyfarm_web");
+    if (IsSkipped() || HasFatalFailure()) return;
+    open_page();
   }
-
-  std::optional<FarmServer> server_;
-  std::optional<WebDriver> driver_;
 };
 
 TEST_F(WebPage, RenderSubmittedFromThePageIsShownLiveListedAndDone) {
