@@ -32,7 +32,7 @@ TEST(AirRefractiveIndex, StandardAirMatchesPublishedCiddorValue) {
 
 TEST(AirRefractiveIndex, SeaLevelUs76At550nm) {
   // US76 sea level is Ciddor's standard state (15 C, 101 325 Pa): n - 1 = 2.7784e-4
-  // at 550 nm (the brief's ~2.77e-4; Bucholtz's Peck & Reeder value is 2.7781e-4).
+  // at 550 nm (the usual ~2.77e-4; Bucholtz's Peck & Reeder value is 2.7781e-4).
   EXPECT_NEAR(air::us76_refractivity(550.0, 0.0), 2.7784e-4, 1e-8);
 }
 

@@ -87,7 +87,7 @@ TEST(RefractedRay, LaplaceExpansionUpTo70DegreesZenith) {
     const double t = std::tan(z * kDegToRad);
     EXPECT_NEAR(refraction_arcmin(us76_shells_550(), 90.0 - z) * 60.0, (A * t - B * t * t * t) * kArcsec, 0.05) << z;
   }
-  // The brief's R(45 deg) ~ 58.3 arcsec is for 10 C, 1010 hPa: US76 (15 C,
+  // The textbook R(45 deg) ~ 58.3 arcsec is for 10 C, 1010 hPa: US76 (15 C,
   // 1013.25 hPa) scaled by the density ratio gives 58.0 arcsec.
   const double density_ratio = (1010.0 / 1013.25) * (288.15 / 283.15);
   EXPECT_NEAR(refraction_arcmin(us76_shells_550(), 45.0) * 60.0 * density_ratio, 58.3, 0.5);
