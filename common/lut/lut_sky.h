@@ -13,6 +13,12 @@
 //   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions (32 mirror-
 //                              paired rings), 20 steps
 //   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
+//   bands, bands_*             bands l = 1..2 of the second order's
+//                              direction dependence: 24 mu_s x 12 altitudes,
+//                              12 x 6 directions, 12 steps
+//                              (multiple_scattering_bands.h)
+//   sky_view_band_*            the sky-view table adds the bands on every
+//                              4th row and 8th column, 16 steps
 //   sky_view_*                 192 azimuths x 108 zenith rows, 30 steps
 //   aerial_*                   32 x 32 x 32 slices up to 64 km
 //   space_view_steps           march steps of a view from above the top (64)
@@ -95,6 +101,12 @@ struct LutResolution {
   int multiple_scattering_directions = 64, multiple_scattering_steps = 20;
   int ground_irradiance_mu_s = 64, ground_irradiance_directions = 64, ground_irradiance_steps = 20;
   int sky_view_azimuth = 192, sky_view_zenith = 108, sky_view_steps = 30;
+  // Multiple-scattering bands (multiple_scattering_bands.h): highest band
+  // (0: Hillaire's isotropic term alone), nodes, directions, steps; and
+  // the sky-view table's coarse grid for them (sky_view_lut.h).
+  int bands = 2;
+  int bands_mu_s = 24, bands_altitude = 12, bands_rings = 12, bands_azimuths = 6, bands_steps = 12;
+  int sky_view_band_row_stride = 4, sky_view_band_column_stride = 8, sky_view_band_steps = 16;
   int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
   double aerial_max_distance_m = 64000.0;
   int space_view_steps = 64;
