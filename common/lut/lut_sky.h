@@ -14,8 +14,8 @@
 //                              paired rings), 20 steps
 //   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
 //   bands, bands_*             bands l = 1..2 of the second order's
-//                              direction dependence: 24 mu_s x 12 altitudes,
-//                              12 x 6 directions, 12 steps
+//                              direction dependence: 24 mu_s x 8 altitudes,
+//                              12 x 4 directions, 8 steps
 //                              (multiple_scattering_bands.h)
 //   sky_view_band_*            the sky-view table adds the bands on every
 //                              4th row and 8th column, 16 steps
@@ -59,12 +59,15 @@
 //
 // Accuracy against the path tracer (tests/common/lut/sky_view_lut_test.cpp;
 // Earth preset with ground albedo 0.3, 440-680 nm): single scattering agrees
-// to < 1 %; with Hillaire's isotropic multiple scattering the whole sky,
-// LUT/PT - 1 over 6 directions x 4 wavelengths, is -19 % (blue, 1 deg above
-// the horizon) to +24 % (red, anti-solar sky 60 deg up) at noon (sun 30 deg)
-// and -28 % (blue, 5 deg above the horizon) to +6 % with the sun at 80 deg.
-// The approximation spreads the light of the aerosols' forward peak over all
-// directions (with an isotropic scatterer the LUT agrees to 1.2 %).
+// to < 1 %; the higher orders are Hillaire's isotropic term plus the
+// multiple-scattering bands (multiple_scattering_bands.h): LUT/PT - 1 over
+// 5 directions x 4 wavelengths is -5 % (blue, 1 deg above the horizon) to
+// +5 % (red, anti-solar sky 60 deg up) at noon (sun 30 deg) and -16 % (blue,
+// 5 deg above the horizon) to +2 % with the sun at 80 deg.  Hillaire's term
+// alone erred by -19 % to +24 % and -28 % to +6 %: it spreads the light of
+// the aerosols' forward peak over all directions.  At twilight (sun 93 deg)
+// the bands make the sky brighter than the path tracer's away from the sun
+// (docs/experiments/2026-12-07-anisotropic-multiple-scattering.md).
 //
 // Cost (tests/bench/lut_bench.cpp, one core, CPU time, 8 / 32 bins,
 // observer on the ground): all tables about 13 / 18-20 ms on the AMD EPYC
@@ -105,7 +108,7 @@ struct LutResolution {
   // (0: Hillaire's isotropic term alone), nodes, directions, steps; and
   // the sky-view table's coarse grid for them (sky_view_lut.h).
   int bands = 2;
-  int bands_mu_s = 24, bands_altitude = 12, bands_rings = 12, bands_azimuths = 6, bands_steps = 12;
+  int bands_mu_s = 24, bands_altitude = 8, bands_rings = 12, bands_azimuths = 4, bands_steps = 8;
   int sky_view_band_row_stride = 4, sky_view_band_column_stride = 8, sky_view_band_steps = 16;
   int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
   double aerial_max_distance_m = 64000.0;

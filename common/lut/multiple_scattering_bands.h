@@ -45,10 +45,13 @@
 //   mu_s_samples     sun zenith cosine nodes (default 24), x in [-1, 1]
 //                    equally spaced with mu_s = x (0.3 + 0.7 |x|): denser
 //                    near the horizon, where the bands change fastest
-//   altitude_samples altitude nodes (default 12), h = top x^2 (denser low
+//   altitude_samples altitude nodes (default 8), h = top x^2 (denser low
 //                    down, where the aerosols are)
-//   rings, azimuths  directions per node (default 12 x 6)
-//   steps            march steps per direction (default 12)
+//   rings, azimuths  directions per node (default 12 x 4)
+//   steps            march steps per direction (default 8)
+// The defaults are the cheapest of those tried that keep the daytime error
+// against the path tracer (docs/experiments/2026-12-07-anisotropic-
+// multiple-scattering.md); twilight wants the 24 mu_s nodes.
 //
 // Layout: [altitude][mu_s][harmonic][bin], single precision.
 #pragma once
@@ -73,7 +76,7 @@ class MultipleScatteringBands {
  public:
   static MultipleScatteringBands build(const MediumTable& medium, const TransmittanceLut& transmittance,
                                        const GroundIrradianceLut& ground, int max_band = 2, int mu_s_samples = 24,
-                                       int altitude_samples = 12, int rings = 12, int azimuths = 6, int steps = 12);
+                                       int altitude_samples = 8, int rings = 12, int azimuths = 4, int steps = 8);
 
   int max_band() const { return max_band_; }
   // Harmonics stored per node and bin: l = 0 .. max_band, all m >= 0

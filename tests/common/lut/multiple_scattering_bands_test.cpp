@@ -105,11 +105,11 @@ TEST(MultipleScatteringBands, MatchBruteForceQuadrature) {
   constexpr int kSteps = 200;
   std::vector<float> table(static_cast<std::size_t>(K * B));
   std::vector<double> s_t(B), s_c(C * B), phase(C * B), Tsun(B), Tr(B), E(B), Y(6);
-  // Nodes: altitude nodes 0 and 2 (h = top (2/11)^2), mu_s nodes 23 (zenith),
+  // Nodes: altitude nodes 0 and 2 (h = top (2/7)^2), mu_s nodes 23 (zenith),
   // 17 (mu_s = 0.385), 13 (0.033), 11 (-0.033).
   for (int j : {0, 2})
     for (int col : {23, 17, 13, 11}) {
-      const double h = top * (j / 11.0) * (j / 11.0), x = -1.0 + 2.0 * col / 23.0;
+      const double h = top * (j / 7.0) * (j / 7.0), x = -1.0 + 2.0 * col / 23.0;
       const double mu_s = x * (0.3 + 0.7 * std::abs(x)), sin_s = std::sqrt(1.0 - mu_s * mu_s);
       const glm::dvec3 o(0.0, 0.0, R + h), s(sin_s, 0.0, mu_s);
       std::vector<double> ref(static_cast<std::size_t>(K * B), 0.0);
@@ -191,7 +191,7 @@ TEST(MultipleScatteringBands, RejectsBadResolution) {
   const GroundIrradianceLut gi = GroundIrradianceLut::build(medium, T, ms);
   EXPECT_THROW(MultipleScatteringBands::build(medium, T, gi, lut::kMaxHarmonicBand + 1), std::invalid_argument);
   EXPECT_THROW(MultipleScatteringBands::build(medium, T, gi, 2, 1), std::invalid_argument);
-  EXPECT_THROW(MultipleScatteringBands::build(medium, T, gi, 2, 24, 12, 12, 0), std::invalid_argument);
+  EXPECT_THROW(MultipleScatteringBands::build(medium, T, gi, 2, 24, 8, 12, 0), std::invalid_argument);
 }
 
 }  // namespace
