@@ -15,7 +15,7 @@
 //   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
 //   bands, bands_*             bands l = 1..2 of the second order's
 //                              direction dependence: 24 mu_s x 8 altitudes,
-//                              12 x 4 directions, 8 steps
+//                              12 x 6 directions, 8 steps
 //                              (multiple_scattering_bands.h)
 //   sky_view_band_*            the sky-view table adds the bands on every
 //                              4th row and 8th column, 16 steps
@@ -70,13 +70,15 @@
 // (docs/experiments/2026-12-07-anisotropic-multiple-scattering.md).
 //
 // Cost (tests/bench/lut_bench.cpp, one core, CPU time, 8 / 32 bins,
-// observer on the ground): all tables about 13 / 18-20 ms on the AMD EPYC
-// (Zen 5) VM they were last measured on (slower VMs take up to ~1.5x), the
-// sun-dependent tables alone (with_sun) about 5.5 ms at 32 bins; one
-// radiance look-up ~0.1 us; memory 5.7 / 16.4 MB (whole 2 MiB pages,
-// huge_page_allocator.h).  Where the time goes, what bounds it and
-// how it got there: docs/experiments/*-lut-build-time.md.  A timelapse or a
-// cache of many suns should build once and call with_sun.
+// observer on the ground): all tables about 21 / 35 ms with the multiple-
+// scattering bands (15 / 23 ms without them: the bands table 12 ms, the
+// sky view 8.2 ms instead of 6.1) on the Xeon VM they were last measured
+// on (medians of 5; faster VMs take ~0.7x), the sun-dependent tables alone
+// (with_sun) about 8.6 ms at 32 bins; one radiance look-up ~0.1 us; memory
+// 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).  Where the time
+// goes, what bounds it and how it got there:
+// docs/experiments/*-lut-build-time.md.  A timelapse or a cache of many suns
+// should build once and call with_sun.
 #pragma once
 #include <atomic>
 #include <cstddef>
@@ -108,7 +110,7 @@ struct LutResolution {
   // (0: Hillaire's isotropic term alone), nodes, directions, steps; and
   // the sky-view table's coarse grid for them (sky_view_lut.h).
   int bands = 2;
-  int bands_mu_s = 24, bands_altitude = 8, bands_rings = 12, bands_azimuths = 4, bands_steps = 8;
+  int bands_mu_s = 24, bands_altitude = 8, bands_rings = 12, bands_azimuths = 6, bands_steps = 8;
   int sky_view_band_row_stride = 4, sky_view_band_column_stride = 8, sky_view_band_steps = 16;
   int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
   double aerial_max_distance_m = 64000.0;

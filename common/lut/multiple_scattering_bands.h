@@ -47,7 +47,7 @@
 //                    near the horizon, where the bands change fastest
 //   altitude_samples altitude nodes (default 8), h = top x^2 (denser low
 //                    down, where the aerosols are)
-//   rings, azimuths  directions per node (default 12 x 4)
+//   rings, azimuths  directions per node (default 12 x 6)
 //   steps            march steps per direction (default 8)
 // The defaults are the cheapest of those tried that keep the daytime error
 // against the path tracer (docs/experiments/2026-12-07-anisotropic-
@@ -76,7 +76,7 @@ class MultipleScatteringBands {
  public:
   static MultipleScatteringBands build(const MediumTable& medium, const TransmittanceLut& transmittance,
                                        const GroundIrradianceLut& ground, int max_band = 2, int mu_s_samples = 24,
-                                       int altitude_samples = 8, int rings = 12, int azimuths = 4, int steps = 8);
+                                       int altitude_samples = 8, int rings = 12, int azimuths = 6, int steps = 8);
 
   int max_band() const { return max_band_; }
   // Harmonics stored per node and bin: l = 0 .. max_band, all m >= 0

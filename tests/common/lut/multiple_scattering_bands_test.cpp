@@ -11,6 +11,8 @@
 #include <cmath>
 #include <vector>
 
+#include <glm/geometric.hpp>
+
 #include "common/atmosphere/atmosphere_builder.h"
 #include "common/core/constants.h"
 #include "common/lut/fibonacci_directions.h"
@@ -83,13 +85,17 @@ TEST(MultipleScatteringBands, PhaseMomentsMatchTheirClosedForms) {
   EXPECT_NEAR(m[4], 0.1, 1e-6);
 }
 
-// The table's a_lm (l >= 1) at its nodes against a brute-force quadrature of the same
-// integral: 8192 spherical-Fibonacci directions (no rings, no mirror
+// The table's a_lm (l >= 1) at its nodes against a brute-force quadrature of
+// the same integral: 8192 spherical-Fibonacci directions (no rings, no mirror
 // symmetry, no control variate), 200 steps each, the same first-order light
 // (exact phase functions, the transmittance table for the sun, the ground's
 // direct sun and sky irradiance).  Earth preset (aerosols g = 0.7), 4 bins.
-// Error measured relative to the largest |a_lm| of the node and bin: worst
-// 1.6 % by day, 3.5 % with the sun below the horizon; tolerance 3 % and 6 %.
+// Error relative to the largest |a_lm| of the node and bin, measured worst:
+// a fine table (32 rings x 16 azimuths, 32 steps) 2.3 %, so the table
+// computes the right integral; the default (12 x 6, 8 steps) 19 %, its own
+// discretisation, which moves the sky by < 0.3 % RMS against the path
+// tracer (docs/experiments/2026-12-07-anisotropic-multiple-scattering.md).
+// Tolerances 3 % and 25 %.
 TEST(MultipleScatteringBands, MatchBruteForceQuadrature) {
   const Atmosphere atm = build_atmosphere(AtmosphereSpec{});
   const SpectralGrid grid(400.0, 720.0, 4);
@@ -98,12 +104,13 @@ TEST(MultipleScatteringBands, MatchBruteForceQuadrature) {
   const MultipleScatteringLut ms = MultipleScatteringLut::build(medium, T);
   const GroundIrradianceLut gi = GroundIrradianceLut::build(medium, T, ms);
   const MultipleScatteringBands bands = MultipleScatteringBands::build(medium, T, gi);
+  const MultipleScatteringBands fine = MultipleScatteringBands::build(medium, T, gi, 2, 24, 8, 32, 16, 32);
   const int B = 4, C = medium.scatterers(), K = bands.harmonics();
   const double R = medium.planet_radius_m(), top = medium.top_altitude_m();
   const std::vector<glm::dvec3> dirs = lut::fibonacci_sphere(8192);
   const double dw = 4.0 * kPi / static_cast<double>(dirs.size());
   constexpr int kSteps = 200;
-  std::vector<float> table(static_cast<std::size_t>(K * B));
+  std::vector<float> table(static_cast<std::size_t>(K * B)), fine_table(static_cast<std::size_t>(K * B));
   std::vector<double> s_t(B), s_c(C * B), phase(C * B), Tsun(B), Tr(B), E(B), Y(6);
   // Nodes: altitude nodes 0 and 2 (h = top (2/7)^2), mu_s nodes 23 (zenith),
   // 17 (mu_s = 0.385), 13 (0.033), 11 (-0.033).
@@ -151,13 +158,17 @@ TEST(MultipleScatteringBands, MatchBruteForceQuadrature) {
           for (int b = 0; b < B; ++b) ref[k * B + b] += dw * Y[k] * L1[b];
       }
       bands.coefficients(h, mu_s, table.data());
+      fine.coefficients(h, mu_s, fine_table.data());
       for (int b = 0; b < B; ++b) {
         double scale = 0.0;
         for (int k = 1; k < K; ++k) scale = std::max(scale, std::abs(ref[k * B + b]));
         ASSERT_GT(scale, 0.0);
-        for (int k = 1; k < K; ++k)
-          EXPECT_NEAR(table[k * B + b], ref[k * B + b], (mu_s > 0.0 ? 0.03 : 0.06) * scale)
-              << "altitude node " << j << " mu_s " << mu_s << " harmonic " << k << " bin " << b;
+        for (int k = 1; k < K; ++k) {
+          EXPECT_NEAR(fine_table[k * B + b], ref[k * B + b], 0.03 * scale)
+              << "fine, altitude node " << j << " mu_s " << mu_s << " harmonic " << k << " bin " << b;
+          EXPECT_NEAR(table[k * B + b], ref[k * B + b], 0.25 * scale)
+              << "default, altitude node " << j << " mu_s " << mu_s << " harmonic " << k << " bin " << b;
+        }
       }
     }
 }

@@ -32,18 +32,19 @@ Sun flat_sun(double zenith_deg, double angular_radius_deg = 0.2666) {
   return Sun(zenith_deg, 0.0, angular_radius_deg, PiecewiseLinear::constant(1.8));
 }
 
-// (1) Table vs reference march (2000 steps, exact phase functions) over a
-// grid of directions, sun positions and two observer altitudes.  Measured
-// worst: 1.05 % by day, 2.8 % at twilight (sun at 96 deg, views 80-88 deg
-// towards it, where the sunlit part of the ray is far away and short: 1.5 %
-// with 60 steps per row).  Tolerances 2 % and 4 %.
+// (1) Table vs reference march (2000 steps, exact phase functions, the
+// multiple-scattering bands on every step) over a grid of directions, sun
+// positions and two observer altitudes.  Measured worst: WORST_DAY by day,
+// WORST_TWILIGHT at twilight (sun at 96 deg, views 80-88 deg towards it, where the sunlit part of
+// the ray is far away and short, and the bands' coarse grid interpolates
+// across it).  Tolerances 2 % and 6 %.
 TEST(LutSkyView, MatchesTheReferenceMarch) {
   const Atmosphere atm = build_atmosphere(AtmosphereSpec{});
   LutResolution res;
   res.spectral_bins = 4;
   const LutSky base = LutSky::build(atm, flat_sun(30.0), 0.0, 400.0, 720.0, res);
   std::vector<double> L(4), ref(4);
-  double worst = 0.0;
+  double worst = 0.0, worst_day = 0.0;
   for (double altitude : {0.0, 5000.0})
     for (double sun_zenith : {30.0, 80.0, 96.0}) {
       const LutSky sky = base.with_sun(flat_sun(sun_zenith), altitude);
@@ -55,13 +56,15 @@ TEST(LutSkyView, MatchesTheReferenceMarch) {
           for (std::size_t b = 0; b < 4; ++b) {
             const double rel = std::abs(L[b] - ref[b]) / ref[b];
             worst = std::max(worst, rel);
-            EXPECT_LT(rel, sun_zenith > 90.0 ? 0.04 : 0.02)
+            if (sun_zenith < 90.0) worst_day = std::max(worst_day, rel);
+            EXPECT_LT(rel, sun_zenith > 90.0 ? 0.06 : 0.02)
                 << "altitude " << altitude << " sun " << sun_zenith << " view " << z << "/" << a << " bin " << b;
           }
         }
       EXPECT_EQ(sky.sanitized_values(), 0u);
     }
   RecordProperty("worst_relative_difference", std::to_string(worst));
+  RecordProperty("worst_relative_difference_by_day", std::to_string(worst_day));
 }
 
 // (2) A homogeneous 2 km layer (sigma_s = 5e-8 /m: vertical optical depth
