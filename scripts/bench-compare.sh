@@ -16,7 +16,7 @@ if [ $# -lt 2 ]; then
   exit 2
 fi
 before=$1 after=$2 rounds=${3:-10}
-filter=${4:-'BM_LutBuildAll/(8|32)$|BM_LutBuildPerSun/32$|BM_LutBuildStage/stage:./bins:32'}
+filter=${4:-'BM_LutBuildAll/bins:(8|32)/bands:2$|BM_LutBuildPerSun/32$|BM_LutBuildStage/stage:./bins:32'}
 for binary in "$before" "$after"; do
   [ -x "$binary" ] || { echo "not an executable: $binary" >&2; exit 2; }
 done

@@ -11,6 +11,7 @@
 #include "common/lut/ground_irradiance_lut.h"
 #include "common/lut/invalid_argument.h"
 #include "common/lut/medium_table.h"
+#include "common/lut/multiple_scattering_bands.h"
 #include "common/lut/multiple_scattering_lut.h"
 #include "common/lut/scattering_march.h"
 #include "common/lut/shell_geometry.h"
@@ -28,6 +29,7 @@ struct LutSky::Tables {
   TransmittanceLut transmittance;
   MultipleScatteringLut multiple_scattering;
   GroundIrradianceLut ground_irradiance;
+  MultipleScatteringBands bands;
 };
 
 LutSky LutSky::build(const Atmosphere& atmosphere, const Sun& sun, double observer_altitude_m, double lambda_min_nm,
@@ -45,6 +47,9 @@ LutSky LutSky::build(const Atmosphere& atmosphere, const Sun& sun, double observ
   tables->ground_irradiance = GroundIrradianceLut::build(tables->medium, tables->transmittance,
                                                          tables->multiple_scattering, res.ground_irradiance_mu_s,
                                                          res.ground_irradiance_directions, res.ground_irradiance_steps);
+  tables->bands = MultipleScatteringBands::build(tables->medium, tables->transmittance, tables->ground_irradiance,
+                                                 res.bands, res.bands_mu_s, res.bands_altitude, res.bands_rings,
+                                                 res.bands_azimuths, res.bands_steps);
   LutSky sky;
   sky.tables_ = std::move(tables);
   sky.resolution_ = res;
@@ -73,7 +78,9 @@ LutSky LutSky::with_sun(const Sun& sun, double observer_altitude_m) const {
     const LutResolution& r = resolution_;
     sky.sky_view_ = std::make_shared<const SkyViewLut>(
         SkyViewLut::build(t.medium, t.transmittance, t.multiple_scattering, t.ground_irradiance, sky.observer_r_, mu_s,
-                          sky.sun_E_, r.sky_view_azimuth, r.sky_view_zenith, r.sky_view_steps));
+                          sky.sun_E_, r.sky_view_azimuth, r.sky_view_zenith, r.sky_view_steps, &t.bands,
+                          BandViewGrid{r.sky_view_band_row_stride, r.sky_view_band_column_stride,
+                                       r.sky_view_band_steps}));
     sky.aerial_ = std::make_shared<const AerialPerspectiveLut>(
         AerialPerspectiveLut::build(t.medium, t.transmittance, t.multiple_scattering, sky.observer_r_, mu_s, sky.sun_E_,
                                     r.aerial_azimuth, r.aerial_zenith, r.aerial_slices, r.aerial_max_distance_m));
@@ -213,6 +220,13 @@ void LutSky::march(const glm::dvec3& origin, const glm::dvec3& d, double t_max, 
   std::copy(P, P + CB, P_f);  // (to float, as the march uses it)
   m.add_inscattering(P_f, nu, mu_s0, 0, m.steps(), L);
   m.add_ground(nu, mu_s0, L);
+  // The bands on sky rays, as the sky-view table has them; the aerial
+  // perspective (ground = false) keeps the isotropic term, as its table.
+  // (Clamped at 0 like the table's entries: the bands alone can dip below.)
+  if (ground) {
+    m.add_bands(t.bands, nu, mu_s0, L);
+    for (int b = 0; b < B; ++b) L[b] = std::max(0.0, L[b]);
+  }
   for (int b = 0; b < B; ++b) {
     L[b] *= sun_E_[static_cast<std::size_t>(b)];
     T[b] = m.T_before(m.steps())[b];
@@ -243,7 +257,7 @@ int LutSky::clamped_multiple_scattering_nodes() const { return tables_->multiple
 std::size_t LutSky::memory_bytes() const {
   const Tables& t = *tables_;
   std::size_t n = t.medium.memory_bytes() + t.transmittance.memory_bytes() + t.multiple_scattering.memory_bytes() +
-                  t.ground_irradiance.memory_bytes() + (sun_E_.size() + sun_L_.size()) * sizeof(double);
+                  t.ground_irradiance.memory_bytes() + t.bands.memory_bytes() + (sun_E_.size() + sun_L_.size()) * sizeof(double);
   if (sky_view_) n += sky_view_->memory_bytes();
   if (aerial_) n += aerial_->memory_bytes();
   return n;

@@ -13,6 +13,12 @@
 //   multiple_scattering_*      32 mu_s x 32 altitudes, 64 directions (32 mirror-
 //                              paired rings), 20 steps
 //   ground_irradiance_*        64 mu_s, 64 directions, 20 steps
+//   bands, bands_*             bands l = 1..2 of the second order's
+//                              direction dependence: 24 mu_s x 8 altitudes,
+//                              12 x 6 directions, 8 steps
+//                              (multiple_scattering_bands.h)
+//   sky_view_band_*            the sky-view table adds the bands on every
+//                              4th row and 8th column, 16 steps
 //   sky_view_*                 192 azimuths x 108 zenith rows, 30 steps
 //   aerial_*                   32 x 32 x 32 slices up to 64 km
 //   space_view_steps           march steps of a view from above the top (64)
@@ -53,21 +59,26 @@
 //
 // Accuracy against the path tracer (tests/common/lut/sky_view_lut_test.cpp;
 // Earth preset with ground albedo 0.3, 440-680 nm): single scattering agrees
-// to < 1 %; with Hillaire's isotropic multiple scattering the whole sky,
-// LUT/PT - 1 over 6 directions x 4 wavelengths, is -19 % (blue, 1 deg above
-// the horizon) to +24 % (red, anti-solar sky 60 deg up) at noon (sun 30 deg)
-// and -28 % (blue, 5 deg above the horizon) to +6 % with the sun at 80 deg.
-// The approximation spreads the light of the aerosols' forward peak over all
-// directions (with an isotropic scatterer the LUT agrees to 1.2 %).
+// to < 1 %; the higher orders are Hillaire's isotropic term plus the
+// multiple-scattering bands (multiple_scattering_bands.h): LUT/PT - 1 over
+// 5 directions x 4 wavelengths is -5 % (blue, 1 deg above the horizon) to
+// +5 % (red, anti-solar sky 60 deg up) at noon (sun 30 deg) and -16 % (blue,
+// 5 deg above the horizon) to +2 % with the sun at 80 deg.  Hillaire's term
+// alone erred by -19 % to +24 % and -28 % to +6 %: it spreads the light of
+// the aerosols' forward peak over all directions.  At twilight (sun 93 deg)
+// the bands make the sky brighter than the path tracer's away from the sun
+// (docs/experiments/2026-12-07-anisotropic-multiple-scattering.md).
 //
 // Cost (tests/bench/lut_bench.cpp, one core, CPU time, 8 / 32 bins,
-// observer on the ground): all tables about 13 / 18-20 ms on the AMD EPYC
-// (Zen 5) VM they were last measured on (slower VMs take up to ~1.5x), the
-// sun-dependent tables alone (with_sun) about 5.5 ms at 32 bins; one
-// radiance look-up ~0.1 us; memory 5.7 / 16.4 MB (whole 2 MiB pages,
-// huge_page_allocator.h).  Where the time goes, what bounds it and
-// how it got there: docs/experiments/*-lut-build-time.md.  A timelapse or a
-// cache of many suns should build once and call with_sun.
+// observer on the ground): all tables about 21 / 35 ms with the multiple-
+// scattering bands (15 / 23 ms without them: the bands table 12 ms, the
+// sky view 8.2 ms instead of 6.1) on the Xeon VM they were last measured
+// on (medians of 5; faster VMs take ~0.7x), the sun-dependent tables alone
+// (with_sun) about 8.6 ms at 32 bins; one radiance look-up ~0.1 us; memory
+// 5.7 / 16.4 MB (whole 2 MiB pages, huge_page_allocator.h).  Where the time
+// goes, what bounds it and how it got there:
+// docs/experiments/*-lut-build-time.md.  A timelapse or a cache of many suns
+// should build once and call with_sun.
 #pragma once
 #include <atomic>
 #include <cstddef>
@@ -95,6 +106,12 @@ struct LutResolution {
   int multiple_scattering_directions = 64, multiple_scattering_steps = 20;
   int ground_irradiance_mu_s = 64, ground_irradiance_directions = 64, ground_irradiance_steps = 20;
   int sky_view_azimuth = 192, sky_view_zenith = 108, sky_view_steps = 30;
+  // Multiple-scattering bands (multiple_scattering_bands.h): highest band
+  // (0: Hillaire's isotropic term alone), nodes, directions, steps; and
+  // the sky-view table's coarse grid for them (sky_view_lut.h).
+  int bands = 2;
+  int bands_mu_s = 24, bands_altitude = 8, bands_rings = 12, bands_azimuths = 6, bands_steps = 8;
+  int sky_view_band_row_stride = 4, sky_view_band_column_stride = 8, sky_view_band_steps = 16;
   int aerial_azimuth = 32, aerial_zenith = 32, aerial_slices = 32;
   double aerial_max_distance_m = 64000.0;
   int space_view_steps = 64;

@@ -8,6 +8,7 @@
 #include "common/core/constants.h"
 #include "common/lut/bilinear.h"
 #include "common/lut/invalid_argument.h"
+#include "common/lut/mirrored_rings.h"
 #include "common/lut/segment_integral.h"
 #include "common/lut/shell_geometry.h"
 #include "common/lut/simd_clones.h"
@@ -17,7 +18,6 @@ namespace skyfarm {
 namespace {
 constexpr double kMaxFms = 1.0 - 1e-3;
 constexpr std::size_t kDefaultBins = kDefaultLutBins;
-constexpr double kGoldenRatio = 1.6180339887498949;  // (1 + sqrt 5) / 2
 
 // acc[b] += weight[b] (w00 v00 + w01 v01 + w10 v10 + w11 v11)[b]: a bilinear
 // look-up with its weights given (lut::BilinearF::weighted_add).
@@ -29,34 +29,6 @@ template <class Size>
     acc[b] += weight[b] * (w00 * v00[b] + w01 * v01[b] + w10 * v10[b] + w11 * v11[b]);
 }
 
-// The direction set (header): `rings` zenith cosines, each carrying the
-// mirror pair of azimuths (phi_i, -phi_i) about the sun's vertical plane.
-// Both directions of a pair see the same sun (x_t . s depends on cos phi
-// only), so one is evaluated for both.  On each side of the horizon mu_h the
-// rings are the midpoints of v in [0, 1] with mu = mu_h +- (range) v^2, so
-// that they crowd towards the horizon, where the scattered light changes
-// fastest (the grazing rays' long paths); sides get rings in proportion to
-// their solid angle.  Weights (dmu dphi / 4 pi) sum to 1.  phi_i steps by the
-// golden angle, as in a spherical Fibonacci set.
-struct Rings {
-  std::vector<double> mu, weight, cos_phi;
-};
-
-Rings mirrored_rings(int rings, double mu_h) {
-  Rings out;
-  const int n_ground = std::clamp(static_cast<int>(std::lround(0.5 * rings * (1.0 + mu_h))), 1, rings - 1);
-  const int n_sky = rings - n_ground;
-  for (int i = 0; i < rings; ++i) {
-    const bool sky = i < n_sky;
-    const int n = sky ? n_sky : n_ground;
-    const double range = sky ? 1.0 - mu_h : 1.0 + mu_h;
-    const double v = sky ? 1.0 - (i + 0.5) / n_sky : (i - n_sky + 0.5) / n_ground;
-    out.mu.push_back(sky ? mu_h + range * v * v : mu_h - range * v * v);
-    out.weight.push_back(0.5 * range * 2.0 * v / n);
-    out.cos_phi.push_back(std::cos(2.0 * kPi * i / kGoldenRatio));
-  }
-  return out;
-}
 }  // namespace
 
 SKYFARM_LUT_SIMD_CLONES
@@ -102,7 +74,7 @@ MultipleScatteringLut MultipleScatteringLut::build(const MediumTable& medium, co
   for (int j = 0; j < altitude_samples; ++j) {
     const double r = R + m.top_altitude_ * j / (altitude_samples - 1);
     std::fill(f_ms.begin(), f_ms.end(), 0.0);
-    const Rings rings = mirrored_rings(ring_count, lut::horizon_mu(r, R));
+    const lut::Rings rings = lut::mirrored_rings(ring_count, lut::horizon_mu(r, R));
     for (std::size_t i = 0; i < N; ++i) {
       const double mu = rings.mu[i], sin_theta = std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
       w_dir[i] = rings.weight[i];

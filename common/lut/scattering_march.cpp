@@ -7,6 +7,7 @@
 
 #include "common/core/constants.h"
 #include "common/lut/ground_irradiance_lut.h"
+#include "common/lut/multiple_scattering_bands.h"
 #include "common/lut/segment_integral.h"
 #include "common/lut/shell_geometry.h"
 
@@ -142,6 +143,7 @@ void ScatteringMarch::prepare_steps(double r0, double mu, bool ends_on_ground) {
   const std::size_t S = static_cast<std::size_t>(steps_);
   const double R = medium_.planet_radius_m();
   r0_ = r0;
+  mu_ = mu;
   ends_on_ground_ = ends_on_ground;
   w_c_.resize(S * C * B);
   w_ms_.resize(S * B);
@@ -310,6 +312,25 @@ void ScatteringMarch::add_ground(double nu, double mu_s0, double* L) const {
   const double* T_end = T_before(steps_);
   const std::vector<double>& albedo = medium_.ground_albedo();
   for (std::size_t b = 0; b < B; ++b) L[b] += T_end[b] * albedo[b] * kInvPi * tmp_[b];
+}
+
+void ScatteringMarch::add_bands(const MultipleScatteringBands& bands, double nu, double mu_s0, double* L) const {
+  if (bands.max_band() == 0) return;
+  const std::size_t B = static_cast<std::size_t>(bins_), C = static_cast<std::size_t>(scatterers_);
+  band_coefficients_.resize(static_cast<std::size_t>(bands.harmonics()) * B);
+  const double R = medium_.planet_radius_m();
+  for (std::size_t k = 0; k < static_cast<std::size_t>(steps_); ++k) {
+    if (!(dt_[k] > 0.0)) continue;
+    const double rk = r0_ / c_mu_[k];
+    const double mu_v = std::clamp(c_mu_[k] * mu_ + c_nu_[k], -1.0, 1.0);
+    const double mu_s = std::clamp(c_mu_[k] * mu_s0 + c_nu_[k] * nu, -1.0, 1.0);
+    const double sin_s = std::sqrt(std::max(0.0, (1.0 - mu_s) * (1.0 + mu_s)));
+    const double sin_v = std::sqrt(std::max(0.0, (1.0 - mu_v) * (1.0 + mu_v)));
+    // (A sun at the zenith leaves only the m = 0 harmonics, whatever x_v.)
+    const double x_v = sin_s > 1e-9 ? std::clamp((nu - mu_v * mu_s) / sin_s, -sin_v, sin_v) : 0.0;
+    bands.coefficients(rk - R, mu_s, band_coefficients_.data());
+    bands.add_source(band_coefficients_.data(), mu_v, x_v, w_c_.data() + k * C * B, L);
+  }
 }
 
 }  // namespace skyfarm

@@ -39,6 +39,7 @@
 namespace skyfarm {
 
 class GroundIrradianceLut;
+class MultipleScatteringBands;
 
 class ScatteringMarch {
  public:
@@ -75,6 +76,13 @@ class ScatteringMarch {
                         double* L) const;
   // L[b] += the ground's reflected radiance times T(x_0, x_g), if the ray ends on it.
   void add_ground(double nu, double mu_s0, double* L) const;
+  // L[b] += the second order's direction-dependent part along the ray
+  // (multiple_scattering_bands.h), per unit E_sun: at each step x_k the
+  // view and the sun in x_k's own frame (mu_v(t) = (r_0 mu + t) / r_t, and
+  // x_v = (nu - mu_v mu_s) / sin_s, the view's component towards the sun's
+  // azimuth), the bands' coefficients there, weighted by the step's
+  // per-scatterer weights.
+  void add_bands(const MultipleScatteringBands& bands, double nu, double mu_s0, double* L) const;
 
  private:
   void prepare_steps(double r0, double mu, bool ends_on_ground);
@@ -87,7 +95,7 @@ class ScatteringMarch {
   const GroundIrradianceLut* gi_;
   int bins_, scatterers_, steps_ = 0;
   bool ends_on_ground_ = false;
-  double r0_ = 0.0, t_end_ = 0.0;
+  double r0_ = 0.0, mu_ = 0.0, t_end_ = 0.0;
   std::vector<double> t_mid_, dt_;
   // Per step: weights T(x_0, x_k-) int_k exp(-sigma_t s) ds sigma_s,c ([k][c][b])
   // and the same with the total sigma_s ([k][b]); T before each step ([k][b]).
@@ -101,6 +109,7 @@ class ScatteringMarch {
   mutable std::vector<double> tmp_, u_T_, u_ms_, mu0_;
   mutable std::vector<float> w_phase_, L_f_, rows_T_, rows_M_, frac_T_, frac_ms_;
   mutable std::vector<int> node_T_, node_ms_;
+  mutable std::vector<float> band_coefficients_;
 };
 
 }  // namespace skyfarm

@@ -16,6 +16,15 @@
 // seen through the air in between.  The sun disk itself is not in the table
 // (lut_sky.h adds it).
 //
+// With multiple-scattering bands (multiple_scattering_bands.h), their
+// direction-dependent second-order light is marched on a coarser grid of
+// the same layout (every row_stride-th row of each half and every
+// column_stride-th column, plus each half's last row and the last column,
+// with `steps` steps), interpolated bilinearly within each half and added;
+// an entry that the bands would make negative is clamped to 0.  The bands
+// change smoothly over the sky (they are a few harmonics), so the coarse
+// grid costs little accuracy and a fraction of the full grid's look-ups.
+//
 // Cost: the march of each row (steps, coefficients, exponentials) is done
 // once and shared by all its columns, which only repeat the sun-dependent
 // look-ups (rows share the altitude profile of their zenith angle); those
@@ -36,6 +45,13 @@
 
 namespace skyfarm {
 
+class MultipleScatteringBands;
+
+// Where the sky-view table evaluates the bands (above).
+struct BandViewGrid {
+  int row_stride = 4, column_stride = 8, steps = 16;
+};
+
 class SkyViewLut {
  public:
   // observer_radius_m: R <= r <= R_top; mu_s: cos of the sun's zenith angle
@@ -43,7 +59,8 @@ class SkyViewLut {
   static SkyViewLut build(const MediumTable& medium, const TransmittanceLut& transmittance,
                           const MultipleScatteringLut& multiple_scattering, const GroundIrradianceLut& ground,
                           double observer_radius_m, double mu_s, std::span<const double> sun_irradiance,
-                          int azimuth_columns = 192, int zenith_rows = 108, int steps = 30);
+                          int azimuth_columns = 192, int zenith_rows = 108, int steps = 30,
+                          const MultipleScatteringBands* bands = nullptr, const BandViewGrid& band_grid = {});
 
   // Radiance per bin for a view with zenith cosine mu and cos(phi), phi the
   // azimuth from the sun's (bilinear within the sky or the ground half).
@@ -53,6 +70,9 @@ class SkyViewLut {
   std::size_t memory_bytes() const { return table_memory_bytes(values_); }
 
  private:
+  void add_bands(const MediumTable& medium, const TransmittanceLut& transmittance, const MultipleScatteringBands& bands,
+                 double r, double mu_s, std::span<const double> sun_irradiance, const BandViewGrid& grid);
+
   int bins_ = 0;
   lut::ViewMapping mapping_;
   TableVector<float> values_;  // [row][column][bin], single precision (2.7 MB instead of 5.3 at 32 bins)

@@ -76,6 +76,11 @@ LutResolution RadianceControl::lut_resolution(int bins) {
   r.aerial_azimuth = 4;
   r.aerial_zenith = 4;
   r.aerial_slices = 4;
+  // Hillaire's isotropic term alone: a control and a guide stay unbiased
+  // whatever sky they are given, the bands would cost every path-traced
+  // render another table, and without them a path-traced image keeps its
+  // bytes.
+  r.bands = 0;
   return r;
 }
 

@@ -1,12 +1,15 @@
 // Benchmarks of the LUT renderer (common/lut/): building the tables, one
 // radiance look-up, and how many spectral bins colour needs.
 //
-//   BM_LutBuildAll/N          all tables for one sun position, N bins, one core
+//   BM_LutBuildAll/N/bands    all tables for one sun position, N bins, one
+//                             core, with multiple-scattering bands up to
+//                             `bands` (0: Hillaire's isotropic term alone)
 //   BM_LutBuildPerSun/N       the sun-dependent tables only (sky view + aerial
 //                             perspective; LutSky::with_sun reuses the rest)
 //   BM_LutBuildStage/S/N      one stage: 0 medium, 1 transmittance, 2 multiple
 //                             scattering, 3 ground irradiance, 4 sky view,
-//                             5 aerial perspective
+//                             5 aerial perspective, 6 multiple-scattering
+//                             bands, 7 sky view with the bands
 //   BM_LutRadiance/N          LutSky::radiance from warm tables
 //   BM_LutBinCountColourError/N   colour of the sky-view radiance with N bins
 //                             against N = 94 (5 nm): counters max_rel_dY
@@ -14,7 +17,7 @@
 //                             distance), per sun position and overall
 //
 // Scene: Earth preset (air, ozone 300 DU, aerosols), AM0 sun, observer on the
-// ground, 360-830 nm.  The figures quoted for the LUT sky are BM_LutBuildAll/32,
+// ground, 360-830 nm.  The figures quoted for the LUT sky are BM_LutBuildAll/bins:32/bands:2,
 // BM_LutBuildPerSun/32 and BM_LutRadiance/32 (docs/experiments/*-lut-build-time.md).
 #include <benchmark/benchmark.h>
 
@@ -28,6 +31,7 @@
 #include "common/lut/aerial_perspective_lut.h"
 #include "common/lut/ground_irradiance_lut.h"
 #include "common/lut/lut_sky.h"
+#include "common/lut/multiple_scattering_bands.h"
 #include "common/lut/sky_view_lut.h"
 
 namespace skyfarm {
@@ -60,11 +64,15 @@ const LutSky& warm_sky(int n) {
 }
 
 void BM_LutBuildAll(benchmark::State& state) {
-  const LutResolution res = bins(static_cast<int>(state.range(0)));
+  LutResolution res = bins(static_cast<int>(state.range(0)));
+  res.bands = static_cast<int>(state.range(1));
   const Sun sun = am0_sun(40.0, 120.0);
   for (auto _ : state) benchmark::DoNotOptimize(LutSky::build(atmosphere(), sun, 0.0, 360.0, 830.0, res));
 }
-BENCHMARK(BM_LutBuildAll)->Arg(8)->Arg(16)->Arg(32)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LutBuildAll)
+    ->ArgsProduct({{8, 16, 32}, {0, 2}})
+    ->ArgNames({"bins", "bands"})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_LutBuildPerSun(benchmark::State& state) {
   const LutSky& base = warm_sky(static_cast<int>(state.range(0)));
@@ -80,6 +88,7 @@ void BM_LutBuildStage(benchmark::State& state) {
   const TransmittanceLut T = TransmittanceLut::build(medium);
   const MultipleScatteringLut ms = MultipleScatteringLut::build(medium, T);
   const GroundIrradianceLut gi = GroundIrradianceLut::build(medium, T, ms);
+  const MultipleScatteringBands bands = MultipleScatteringBands::build(medium, T, gi);
   const std::vector<double> E(static_cast<std::size_t>(n), 1.5);
   const double R = atmosphere().planet_radius_m(), mu_s = std::cos(40.0 * kDegToRad);
   for (auto _ : state) {
@@ -99,14 +108,20 @@ void BM_LutBuildStage(benchmark::State& state) {
       case 4:
         benchmark::DoNotOptimize(SkyViewLut::build(medium, T, ms, gi, R, mu_s, E));
         break;
-      default:
+      case 5:
         benchmark::DoNotOptimize(AerialPerspectiveLut::build(medium, T, ms, R, mu_s, E));
+        break;
+      case 6:
+        benchmark::DoNotOptimize(MultipleScatteringBands::build(medium, T, gi));
+        break;
+      default:
+        benchmark::DoNotOptimize(SkyViewLut::build(medium, T, ms, gi, R, mu_s, E, 192, 108, 30, &bands));
         break;
     }
   }
 }
 BENCHMARK(BM_LutBuildStage)
-    ->ArgsProduct({{0, 1, 2, 3, 4, 5}, {8, 16, 32}})
+    ->ArgsProduct({{0, 1, 2, 3, 4, 5, 6, 7}, {8, 16, 32}})
     ->ArgNames({"stage", "bins"})
     ->Unit(benchmark::kMillisecond);
 

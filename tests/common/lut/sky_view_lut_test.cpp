@@ -32,18 +32,19 @@ Sun flat_sun(double zenith_deg, double angular_radius_deg = 0.2666) {
   return Sun(zenith_deg, 0.0, angular_radius_deg, PiecewiseLinear::constant(1.8));
 }
 
-// (1) Table vs reference march (2000 steps, exact phase functions) over a
-// grid of directions, sun positions and two observer altitudes.  Measured
-// worst: 1.05 % by day, 2.8 % at twilight (sun at 96 deg, views 80-88 deg
-// towards it, where the sunlit part of the ray is far away and short: 1.5 %
-// with 60 steps per row).  Tolerances 2 % and 4 %.
+// (1) Table vs reference march (2000 steps, exact phase functions, the
+// multiple-scattering bands on every step) over a grid of directions, sun
+// positions and two observer altitudes.  Measured worst: 1.04 % by day,
+// 4.1 % at twilight (sun at 96 deg, views 80-88 deg towards it, where the
+// sunlit part of the ray is far away and short, and the bands' coarse grid
+// interpolates across it).  Tolerances 2 % and 6 %.
 TEST(LutSkyView, MatchesTheReferenceMarch) {
   const Atmosphere atm = build_atmosphere(AtmosphereSpec{});
   LutResolution res;
   res.spectral_bins = 4;
   const LutSky base = LutSky::build(atm, flat_sun(30.0), 0.0, 400.0, 720.0, res);
   std::vector<double> L(4), ref(4);
-  double worst = 0.0;
+  double worst = 0.0, worst_day = 0.0;
   for (double altitude : {0.0, 5000.0})
     for (double sun_zenith : {30.0, 80.0, 96.0}) {
       const LutSky sky = base.with_sun(flat_sun(sun_zenith), altitude);
@@ -55,13 +56,15 @@ TEST(LutSkyView, MatchesTheReferenceMarch) {
           for (std::size_t b = 0; b < 4; ++b) {
             const double rel = std::abs(L[b] - ref[b]) / ref[b];
             worst = std::max(worst, rel);
-            EXPECT_LT(rel, sun_zenith > 90.0 ? 0.04 : 0.02)
+            if (sun_zenith < 90.0) worst_day = std::max(worst_day, rel);
+            EXPECT_LT(rel, sun_zenith > 90.0 ? 0.06 : 0.02)
                 << "altitude " << altitude << " sun " << sun_zenith << " view " << z << "/" << a << " bin " << b;
           }
         }
       EXPECT_EQ(sky.sanitized_values(), 0u);
     }
   RecordProperty("worst_relative_difference", std::to_string(worst));
+  RecordProperty("worst_relative_difference_by_day", std::to_string(worst_day));
 }
 
 // (2) A homogeneous 2 km layer (sigma_s = 5e-8 /m: vertical optical depth
@@ -106,13 +109,15 @@ TEST(LutSingleScattering, ThinLayerMatchesTheIntegral) {
 // Earth preset (air, ozone 300 DU, aerosols tau 0.1 g 0.7, ground albedo
 // 0.3), observer on the ground, bins centred on 440/520/600/680 nm.
 // The LUT's single scattering agrees with the path tracer's to < 1 %
-// (measured with max_depth 1); the rest is Hillaire's approximation of the
-// higher orders (isotropic phase for the light they carry, 1/(1 - f_ms) for
-// their sum), which here mostly misses the aerosols' forward peak: with an
-// isotropic scatterer the same LUT agrees to 1 % (multiple_scattering_lut_test).
-// `bias` is LUT / PT - 1 measured with 300 000 paths per entry (standard
-// error 0.1-0.7 %); the test allows 3 % plus 4 of its own standard errors
-// around it, so a change of the LUT in either direction fails.
+// (measured with max_depth 1); the rest is the approximation of the higher
+// orders: Hillaire's isotropic term plus the multiple-scattering bands
+// (multiple_scattering_bands.h).  Hillaire's term alone erred by -19 % (blue,
+// 1 deg above the horizon) to +24 % (anti-solar sky 60 deg up) at noon and
+// -28 % to +6 % with the sun at 80 deg; with the bands -5 % to +5 % at noon
+// and -16 % to +2 % at 80 deg.  `bias` is LUT / PT - 1 measured with
+// 100 000 paths per entry (standard error 0.1-0.4 %); the test allows 3 %
+// plus 4 of its own standard errors around it, so a change of the LUT in
+// either direction fails.
 struct PathTracerCase {
   double zenith, azimuth;
   double bias[4];  // at 440, 520, 600, 680 nm
@@ -144,19 +149,19 @@ void expect_agrees_with_path_tracer(double sun_zenith, const std::vector<PathTra
 }
 
 TEST(LutSkyView, NoonAgreesWithThePathTracer) {
-  expect_agrees_with_path_tracer(30.0, {{0.0, 0.0, {0.011, 0.043, 0.065, 0.077}},
-                                        {45.0, 0.0, {-0.021, -0.002, 0.006, 0.011}},
-                                        {70.0, 90.0, {-0.047, 0.023, 0.079, 0.133}},
-                                        {60.0, 180.0, {-0.008, 0.087, 0.166, 0.237}},
-                                        {89.0, 0.0, {-0.191, -0.136, -0.106, -0.085}}});
+  expect_agrees_with_path_tracer(30.0, {{0.0, 0.0, {-0.001, -0.005, -0.008, -0.008}},
+                                        {45.0, 0.0, {-0.014, -0.006, -0.005, -0.003}},
+                                        {70.0, 90.0, {-0.033, -0.007, 0.011, 0.027}},
+                                        {60.0, 180.0, {-0.026, 0.001, 0.027, 0.050}},
+                                        {89.0, 0.0, {-0.046, -0.034, -0.027, -0.022}}});
 }
 
 TEST(LutSkyView, LowSunAgreesWithThePathTracer) {
-  expect_agrees_with_path_tracer(80.0, {{0.0, 0.0, {-0.059, -0.014, 0.036, 0.060}},
-                                        {45.0, 0.0, {-0.126, -0.095, -0.078, -0.066}},
-                                        {70.0, 90.0, {-0.174, -0.125, -0.086, -0.049}},
-                                        {60.0, 180.0, {-0.149, -0.103, -0.053, -0.013}},
-                                        {85.0, 90.0, {-0.282, -0.192, -0.145, -0.107}}});
+  expect_agrees_with_path_tracer(80.0, {{0.0, 0.0, {-0.007, -0.016, -0.024, -0.036}},
+                                        {45.0, 0.0, {-0.018, -0.001, 0.013, 0.020}},
+                                        {70.0, 90.0, {-0.091, -0.060, -0.054, -0.048}},
+                                        {60.0, 180.0, {-0.052, -0.026, -0.008, 0.016}},
+                                        {85.0, 90.0, {-0.160, -0.121, -0.096, -0.085}}});
 }
 
 }  // namespace
