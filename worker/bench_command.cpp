@@ -19,6 +19,7 @@
 #include "worker/bench_lut_clouds.h"
 #include "worker/bench_lut_vs_path.h"
 #include "worker/bench_objects.h"
+#include "worker/bench_sky_accuracy.h"
 #include "worker/cli_io.h"
 #include "worker/demo_requests.h"
 
@@ -125,6 +126,8 @@ int run_bench_command(const std::vector<std::string>& args) {
       return run_bench_lut_clouds(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "objects") {
       return run_bench_objects(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
+    } else if (args[i] == "sky-accuracy") {
+      return run_bench_sky_accuracy(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "efficiency") {
       return run_bench_efficiency(std::vector<std::string>(args.begin() + static_cast<std::ptrdiff_t>(i), args.end()));
     } else if (args[i] == "paths" || args[i] == "demo" || args[i] == "memory" || args[i] == "all") {
@@ -136,6 +139,8 @@ int run_bench_command(const std::vector<std::string>& args) {
                    "[--sunlit-segments]\n"
                    "       skyfarm-worker bench lut-vs-path [--out DIR] [--spp N]\n"
                    "       skyfarm-worker bench lut-clouds [--out DIR] [--spp N]\n"
+                   "       skyfarm-worker bench sky-accuracy [--reference FILE] [--out DIR] [--cases N] [--threads N] "
+                   "[--repeat N] [--reference-samples N]\n"
                    "       skyfarm-worker bench objects [paths|mirror|all] [--repeat N] [--passes P] [--seeds K] "
                    "[--reference-passes R]\n";
       return 2;

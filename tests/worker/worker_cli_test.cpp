@@ -178,6 +178,15 @@ TEST(WorkerCli, BenchEfficiencyPrintsOneLinePerSun) {
   EXPECT_EQ(run_worker("bench efficiency --bogus").exit_code, 2);
 }
 
+// The sky-accuracy bench is wired (a full run traces minutes: README,
+// "Accuracy"): an unknown flag and a flag without its value are usage errors.
+TEST(WorkerCli, BenchSkyAccuracyRejectsBadFlags) {
+  const CommandResult bogus = run_worker("bench sky-accuracy --bogus 1");
+  EXPECT_EQ(bogus.exit_code, 2);
+  EXPECT_NE(bogus.out.find("sky-accuracy [--reference FILE]"), std::string::npos) << bogus.out;
+  EXPECT_EQ(run_worker("bench sky-accuracy --cases").exit_code, 2);
+}
+
 // The objects bench, its paths part once: a line per view and scene, the
 // balls' line with its ratio to the empty sky; the mirror part small, its
 // error falling from the first pass to the last.
