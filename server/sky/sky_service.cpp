@@ -170,6 +170,7 @@ std::shared_ptr<const SkyTable> build_sky_table(const SkyTableParams& p) {
   const Atmosphere atmosphere = build_atmosphere(p.atmosphere);
   Sun sun = table_sun(p);
   LutSky sky = LutSky::build(atmosphere, sun, p.altitude_m, p.min_nm, p.max_nm, p.resolution);
+  if (p.atmosphere.refraction) sky = sky.refracted();
   return finish_table(p, std::move(sky), std::move(sun), start);
 }
 
@@ -177,6 +178,7 @@ std::shared_ptr<const SkyTable> sky_table_for_sun(const SkyTable& donor, const S
   const auto start = std::chrono::steady_clock::now();
   Sun sun = table_sun(p);
   LutSky sky = donor.sky.with_sun(sun, p.altitude_m);
+  if (p.atmosphere.refraction) sky = sky.refracted();
   return finish_table(p, std::move(sky), std::move(sun), start);
 }
 
