@@ -50,6 +50,9 @@ void trace_bent_path(const RefractiveShells& shells, const glm::dvec3& o, const 
     t += length;
     previous = p;
   }
+  // A start on the ground looking down meets it at once: one empty chord, so
+  // that the path still ends there (not in space).
+  if (out->chords.empty() && ray.outcome == RefractedRay::Outcome::kHitGround) out->chords.push_back(Chord{o, d, 0.0, 0.0});
   out->in_atmosphere = !out->chords.empty();
   out->t_enter = r >= shells.top_radius_m() && out->in_atmosphere ? out->chords.front().length : 0.0;
   out->t_end = t;
@@ -58,7 +61,7 @@ void trace_bent_path(const RefractiveShells& shells, const glm::dvec3& o, const 
                             : d;
   // A ray from above that enters and leaves again at once has one vacuum
   // chord only: it never was in the air.
-  if (out->in_atmosphere && out->t_enter >= out->t_end) out->in_atmosphere = false;
+  if (out->in_atmosphere && r >= shells.top_radius_m() && out->t_enter >= out->t_end) out->in_atmosphere = false;
 }
 
 BentShellWalk::BentShellWalk(const BentPath& path, double planet_radius_m, std::span<const double> shell_bottoms,
