@@ -8,6 +8,12 @@
 #include "common/core/constants.h"
 
 namespace skyfarm {
+namespace {
+
+// How far a chord may stray from the curved path it stands for, m.
+constexpr double kMaxSagitta_m = 1.0;
+
+}  // namespace
 
 std::size_t BentPath::chord_at(double t) const {
   // The first chord whose end lies beyond t.
@@ -39,17 +45,43 @@ void trace_bent_path(const RefractiveShells& shells, const glm::dvec3& o, const 
   const double zenith_deg = std::atan2(horizontal, cos_z) * kRadToDeg;
   const RefractedRay ray = trace_refracted_ray(shells, r, zenith_deg, true);
   out->outcome = ray.outcome;
-  glm::dvec3 previous = o;
+  // Consecutive pieces merge into one chord while the arc they replace stays
+  // within kMaxSagitta_m of it: the chord's length times the angle its pieces
+  // turn through, over 4, bounds how far the path strays from it.  A steep
+  // ray (turning < 1e-7 rad per shell) becomes a few chords, a grazing one
+  // keeps ~15 km chords near the ground; every chord's ends are still points
+  // of the exact path.  The entry from space is always a vertex (t_enter).
+  const bool from_space = r >= shells.top_radius_m();
+  glm::dvec3 start = o, previous = o, first_direction(0.0);
   double t = 0.0;
+  bool open = false;  // a chord from `start` to `previous` waits to be closed
+  auto close = [&] {
+    const glm::dvec3 step = previous - start;
+    const double length = glm::length(step);
+    out->chords.push_back(Chord{start, step / length, t, length});
+    t += length;
+    start = previous;
+    open = false;
+  };
   for (std::size_t i = 1; i < ray.path.size(); ++i) {
     const glm::dvec3 p = path_point(ray.path[i], up, forward);
-    const glm::dvec3 step = p - previous;
-    const double length = glm::length(step);
-    if (!(length > 0.0)) continue;  // a turning point on a boundary
-    out->chords.push_back(Chord{previous, step / length, t, length});
-    t += length;
+    const glm::dvec3 piece = p - previous;
+    const double piece_length = glm::length(piece);
+    if (!(piece_length > 0.0)) continue;  // a turning point on a boundary
+    const glm::dvec3 direction = piece / piece_length;
+    if (open) {
+      const double turn = glm::length(glm::cross(direction, first_direction));  // sin, exact when small
+      const double length = glm::length(p - start);
+      if (length * turn > 4.0 * kMaxSagitta_m) close();
+    }
+    if (!open) {
+      first_direction = direction;
+      open = true;
+    }
     previous = p;
+    if (from_space && i == 1) close();  // the straight stretch down to the top
   }
+  if (open) close();
   // A start on the ground looking down meets it at once: one empty chord, so
   // that the path still ends there (not in space).
   if (out->chords.empty() && ray.outcome == RefractedRay::Outcome::kHitGround) out->chords.push_back(Chord{o, d, 0.0, 0.0});

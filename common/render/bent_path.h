@@ -1,11 +1,12 @@
 // A ray of the path tracer bent by refraction: the exact curved path of
-// refracted_ray.h (every refractive-shell boundary and turning point on it)
-// as a polyline of straight chords, in planet-centred coordinates, with the
-// arc-length-like parameter t running along the chords.  Between two of its
-// points a chord departs from the arc by (chord length)^2 / (8 x the ray's
-// radius of curvature, >= ~30 000 km in air): < 1 cm for a 2 km shell
-// crossed steeply, a few hundred metres for a ray grazing a shell over
-// ~300 km; the points themselves are on the curved path.
+// refracted_ray.h (its points at the refractive-shell boundaries and turning
+// points) as a polyline of straight chords, in planet-centred coordinates,
+// with the arc-length-like parameter t running along the chords.  Each
+// chord joins two points of the exact path; consecutive pieces are merged
+// into one chord while the path strays from it by less than 1 m (length x
+// turning angle / 4; the ray's radius of curvature is >= ~30 000 km in
+// air): a steep ray is a few chords, a grazing one ~15 km chords near the
+// ground and longer ones above.
 //
 // BentShellWalk walks the chords through the majorant shells
 // (shell_traversal.h per chord, chord after chord), so free-flight sampling
