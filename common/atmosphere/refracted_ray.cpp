@@ -32,6 +32,15 @@ double sweep(double k, double beta, double r_a, double s_a, double A_a, double r
 RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer_radius_m, double zenith_deg,
                                  bool record_path) {
   RefractedRay out;
+  trace_refracted_ray(shells, observer_radius_m, zenith_deg, record_path, &out);
+  return out;
+}
+
+void trace_refracted_ray(const RefractiveShells& shells, double observer_radius_m, double zenith_deg,
+                         bool record_path, RefractedRay* result) {
+  RefractedRay& out = *result;
+  out.path.clear();
+  out = RefractedRay{RefractedRay::Outcome::kEscaped, std::move(out.path)};
   const double z0 = std::clamp(zenith_deg, 0.0, 180.0) * kDegToRad;
   const double top = shells.top_radius_m();
   double r = std::max(observer_radius_m, shells.ground_radius_m());
@@ -52,7 +61,7 @@ RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer
     if (up || k >= top) {
       out.lowest_radius_m = up ? r : k;
       out.exit_direction_rad = z0;
-      return out;
+      return;
     }
     phi = turning_angle(k, r) - turning_angle(k, top);
     r = s = top;
@@ -89,7 +98,7 @@ RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer
       if (!up && shell == 0) {
         out.lowest_radius_m = r;
         out.outcome = RefractedRay::Outcome::kHitGround;
-        return out;
+        return;
       }
       shell += up ? 1 : -1;
     } else {
@@ -109,12 +118,11 @@ RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer
   }
   if (!escaped) {
     out.outcome = RefractedRay::Outcome::kTrapped;
-    return out;
+    return;
   }
   // Out through the top into vacuum: n = 1 there, sin z = k / r_top, going up.
   out.exit_direction_rad = phi + std::atan2(k, std::sqrt(std::max(0.0, (top - k) * (top + k))));
   out.bending_rad = out.exit_direction_rad - z0;
-  return out;
 }
 
 glm::dvec3 path_point(const RayVertex& vertex, const glm::dvec3& up, const glm::dvec3& forward) {

@@ -94,7 +94,7 @@ std::optional<double> AtmosphereRefraction::apparent_elevation_deg(double altitu
   const auto lowest = true_elevation_deg(altitude_m, lo, lambda_nm);
   if (!lowest || true_deg < *lowest) return std::nullopt;
   if (true_deg >= 90.0) return 90.0;
-  for (int k = 0; k < 60 && hi - lo > 1e-10; ++k) {
+  for (int k = 0; k < 60 && hi - lo > 1e-8; ++k) {
     const double mid = 0.5 * (lo + hi);
     const auto t = true_elevation_deg(altitude_m, mid, lambda_nm);
     (t && *t < true_deg ? lo : hi) = mid;

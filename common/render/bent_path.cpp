@@ -43,7 +43,8 @@ void trace_bent_path(const RefractiveShells& shells, const glm::dvec3& o, const 
   }
   // The zenith angle from the sine and cosine, exact near 0 and 180 degrees.
   const double zenith_deg = std::atan2(horizontal, cos_z) * kRadToDeg;
-  const RefractedRay ray = trace_refracted_ray(shells, r, zenith_deg, true);
+  thread_local RefractedRay ray;  // its path's storage reused
+  trace_refracted_ray(shells, r, zenith_deg, true, &ray);
   out->outcome = ray.outcome;
   // Consecutive pieces merge into one chord while the arc they replace stays
   // within kMaxSagitta_m of it: the chord's length times the angle its pieces
