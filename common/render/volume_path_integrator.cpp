@@ -679,11 +679,18 @@ bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::
     const double w_A = st->sun_lobe_depth == depth ? st->sun_lobe_weight : 1.0;
     *L += sample_sun(v, c.lambda, c.sampler, c.counters) * w_A;
   }
-  const glm::dvec3& s = scene_.sun().direction();
-  // (Not with refraction: the lobe's rays are straight.)
-  const bool lobe = options_.cloud_sun_lobe && scene_.sun_enabled && !scene_.refraction() &&
-                    ground_distance(radial_ray(Ray{p, s}), scene_.atmosphere().planet_radius_m()) < 0.0;
-  if (lobe) *L += sun_lobe_estimate(optics.phase, p, wo, *st, c);
+  // The lobe's axis: the sun's direction, or with refraction its apparent
+  // direction at p (where the cloud's diffraction peak meets the sun's light).
+  glm::dvec3 s = scene_.sun().direction();
+  bool lobe = options_.cloud_sun_lobe && scene_.sun_enabled;
+  if (lobe && scene_.refraction()) {
+    const auto apparent = scene_.refraction()->apparent_direction(p, s, c.lambda.lambda_nm[0]);
+    lobe = apparent.has_value();
+    if (apparent) s = apparent->direction;
+  } else if (lobe) {
+    lobe = ground_distance(radial_ray(Ray{p, s}), scene_.atmosphere().planet_radius_m()) < 0.0;
+  }
+  if (lobe) *L += sun_lobe_estimate(optics.phase, s, p, wo, *st, c);
   const glm::dvec3 wi = optics.phase.sample_direction(wo, c.sampler.next(), c.sampler.next());
   const double pdf = optics.phase.eval(clamp_cos(glm::dot(wo, wi)));
   if (!(pdf > 0.0)) return false;
@@ -707,10 +714,14 @@ bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::
 // as a shadow ray's do in sample_sun) and the NEE there: the path's
 // throughput times p(wo.wi) / q(wi) (the direction's importance weight)
 // times the balance weight q / (p + q), that is beta p / (p + q).
-SampledSpectrum VolumePathIntegrator::sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& p,
-                                                        const glm::dvec3& wo, const PathState& st,
-                                                        const PathContext& c) const {
-  const glm::dvec3& s = scene_.sun().direction();
+//
+// With refraction the hop from p to the next cloud collision stays straight
+// (over the few km between cloud vertices a ray strays < 1 m from its
+// chord), while the path's own next segment is bent: the two techniques'
+// transport differs by that much.
+SampledSpectrum VolumePathIntegrator::sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& s,
+                                                        const glm::dvec3& p, const glm::dvec3& wo,
+                                                        const PathState& st, const PathContext& c) const {
   const glm::dvec3 wi = phase.sample_direction(s, c.sampler.next(), c.sampler.next());
   const double q = phase.eval(clamp_cos(glm::dot(s, wi)));
   const double p_wo = phase.eval(clamp_cos(glm::dot(wo, wi)));

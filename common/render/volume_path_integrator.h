@@ -278,8 +278,9 @@ class VolumePathIntegrator {
                         PathState* st, SampledSpectrum* L) const;
   // The sun lobe's estimate from the cloud vertex at p (arrived along wo, the
   // phase function `phase`, the path's state st after the albedo).
-  SampledSpectrum sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& p, const glm::dvec3& wo,
-                                    const PathState& st, const PathContext& c) const;
+  // s: the lobe's axis (the sun's direction, or its apparent one at p).
+  SampledSpectrum sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& s, const glm::dvec3& p,
+                                    const glm::dvec3& wo, const PathState& st, const PathContext& c) const;
   // The extent of the bent path from ray.o along ray.d (traced into *path,
   // at the hero wavelength): the air, and the first object or cloud
   // collision met chord after chord.
