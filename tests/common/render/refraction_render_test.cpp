@@ -260,5 +260,36 @@ TEST(RefractionRender, RequestRendersTheLiftedSunPathAndLut) {
   }
 }
 
+// Scenes with objects and clouds keep working with refraction (the bent
+// segments meet them chord by chord; the cloud sun lobe aims at the apparent
+// sun): a glass and a gold ball at the feet and a cumulus layer, at sunset.
+TEST(RefractionRender, ObjectsAndCloudsRenderFinite) {
+  const std::string json = R"({"sun": {"zenith_deg": 89, "azimuth_deg": 270},
+      "camera": {"projection": "perspective", "width": 24, "height": 16, "yaw_deg": 270, "pitch_deg": -10,
+                 "fov_deg": 90},
+      "atmosphere": {"refraction": true},
+      "objects": [{"shape": "sphere", "material": {"name": "bk7", "roughness": 0}, "translate_m": [-4, -0.6, 0.4],
+                   "scale": 0.4},
+                  {"shape": "sphere", "material": {"name": "gold", "roughness": 0.05}, "translate_m": [-4, 0.8, 0.4],
+                   "scale": 0.4}],
+      "clouds": {"layers": [{"type": "cumulus", "coverage": 0.5, "base_m": 1500, "thickness_m": 1000, "seed": 7}]},
+      "quality": {"samples_per_pixel": 2}, "output": {"half": false}, "seed": 5})";
+  const RenderSetup setup = make_render_setup(api::render_spec(api::parse_render_request(json)));
+  ASSERT_TRUE(setup.scene->refraction() && setup.scene->objects() && setup.scene->clouds());
+  const TileRenderer renderer(*setup.scene, *setup.camera, setup.plan);
+  Image image(setup.plan.width, setup.plan.height);
+  const LocalRenderResult result = render_image(renderer, &image, 2);
+  EXPECT_EQ(result.counters.nonfinite, 0u);
+  EXPECT_EQ(result.counters.depth_limit, 0u);
+  double sum = 0.0;
+  for (int y = 0; y < image.height(); ++y)
+    for (int x = 0; x < image.width(); ++x) {
+      const double L = image.luminance(x, y);
+      EXPECT_TRUE(std::isfinite(L) && L >= 0.0) << x << ", " << y;
+      sum += L;
+    }
+  EXPECT_GT(sum, 0.0);
+}
+
 }  // namespace
 }  // namespace skyfarm
