@@ -129,6 +129,11 @@ void LutSky::radiance(const glm::dvec3& view_dir, std::span<double> out, bool in
   sanitize(out.first(static_cast<std::size_t>(B)));
 }
 
+std::optional<RefractedView::Apparent> LutSky::disk_sample_direction(const glm::dvec3& d) const {
+  if (!refraction_) return RefractedView::Apparent{d, 1.0};
+  return refraction_->apparent_direction(d, 550.0);
+}
+
 LutSky LutSky::refracted() const {
   LutSky sky = *this;
   if (!above_)

@@ -74,6 +74,7 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -115,6 +116,12 @@ class LutSky {
   // The same sky seen through refraction ("atmosphere.refraction",
   // refracted_view.h: the look-up's directions mapped, the tables shared).
   LutSky refracted() const;
+  // Where the sun's light from the true direction d shows in radiance() (d
+  // itself without refraction, its apparent direction at 550 nm with), and
+  // the solid angle ratio there (1, or dw_apparent / dw_true): a splat of
+  // the disk samples the true disk and puts each sample there, its solid
+  // angle times the ratio.  nullopt where the planet hides it.
+  std::optional<RefractedView::Apparent> disk_sample_direction(const glm::dvec3& d) const;
 
   const SpectralGrid& grid() const;
   // E_sun and the disk's radiance per bin (bin means).

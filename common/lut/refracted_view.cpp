@@ -56,4 +56,21 @@ std::optional<glm::dvec3> RefractedView::true_direction(const glm::dvec3& v, dou
   return with_elevation(v, *e_true);
 }
 
+std::optional<RefractedView::Apparent> RefractedView::apparent_direction(const glm::dvec3& d,
+                                                                       double lambda_nm) const {
+  constexpr double kStep_deg = 1e-3;
+  const double e = std::asin(std::clamp(d.z, -1.0, 1.0)) * kRadToDeg;
+  const auto e_app = table_.apparent_elevation_deg(e, lambda_nm);
+  if (!e_app) return std::nullopt;
+  const auto below = table_.apparent_elevation_deg(e - kStep_deg, lambda_nm);
+  const auto above = table_.apparent_elevation_deg(std::min(90.0, e + kStep_deg), lambda_nm);
+  double ratio = 1.0;
+  const double cos_e = std::cos(e * kDegToRad);
+  if (above && cos_e > 1e-12) {
+    const double lo = below ? e - kStep_deg : e, e_lo = below ? *below : *e_app;
+    ratio = std::cos(*e_app * kDegToRad) / cos_e * (*above - e_lo) / (std::min(90.0, e + kStep_deg) - lo);
+  }
+  return Apparent{with_elevation(d, *e_app), ratio};
+}
+
 }  // namespace skyfarm

@@ -38,6 +38,14 @@ class RefractedView {
   glm::dvec3 sky_direction(const glm::dvec3& v) const;
   // The true direction of the source seen along v at lambda; nullopt where the ray meets the ground.
   std::optional<glm::dvec3> true_direction(const glm::dvec3& v, double lambda_nm) const;
+  // The inverse: where a source in the true direction d appears (at
+  // lambda), and dw_apparent / dw_true there (its disk's solid angle shrinks
+  // by it); nullopt where the planet hides it.
+  struct Apparent {
+    glm::dvec3 direction;
+    double solid_angle_ratio = 1.0;
+  };
+  std::optional<Apparent> apparent_direction(const glm::dvec3& d, double lambda_nm) const;
   const RefractionTable& table() const { return table_; }
 
  private:
