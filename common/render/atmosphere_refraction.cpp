@@ -81,10 +81,15 @@ std::optional<double> AtmosphereRefraction::true_elevation_deg(double altitude_m
   return (1.0 - w) * *a + w * *b;
 }
 
-// Bisection on the interpolated map (increasing in e without ducts, as each
-// table's is), from the lowest apparent elevation both nodes trace.
+// Newton's method on the interpolated map (increasing in e without ducts, as
+// each table's is), safeguarded by a bracket from the lowest apparent
+// elevation both nodes trace to 90 deg: a step that leaves the bracket is a
+// bisection instead.  From the guess e = t + R(t) it takes ~3 steps (two
+// look-ups each) where plain bisection took ~33, and it stops where the map
+// returns the true elevation to 1e-10 deg (or the bracket is 1e-9 deg wide).
 std::optional<double> AtmosphereRefraction::apparent_elevation_deg(double altitude_m, double true_deg,
                                                                    double lambda_nm) const {
+  constexpr double kStep_deg = 1e-6;
   int i;
   double w;
   bracket(altitude_m, &i, &w);
@@ -94,12 +99,25 @@ std::optional<double> AtmosphereRefraction::apparent_elevation_deg(double altitu
   const auto lowest = true_elevation_deg(altitude_m, lo, lambda_nm);
   if (!lowest || true_deg < *lowest) return std::nullopt;
   if (true_deg >= 90.0) return 90.0;
-  for (int k = 0; k < 60 && hi - lo > 1e-8; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    const auto t = true_elevation_deg(altitude_m, mid, lambda_nm);
-    (t && *t < true_deg ? lo : hi) = mid;
+  const auto guess = tables_[i].refraction_deg(std::max(true_deg, lo), lambda_nm);
+  double e = std::clamp(true_deg + (guess ? *guess : 0.0), lo, hi);
+  for (int k = 0; k < 60 && hi - lo > 1e-9; ++k) {
+    const auto t = true_elevation_deg(altitude_m, e, lambda_nm);
+    if (!t) {  // (not inside the bracket but for round-off) bisect
+      lo = e;
+      e = 0.5 * (lo + hi);
+      continue;
+    }
+    const double miss = *t - true_deg;
+    if (std::abs(miss) < 1e-10) return e;
+    (miss < 0.0 ? lo : hi) = e;
+    const double e_step = std::min(hi, e + kStep_deg);
+    const auto t_step = true_elevation_deg(altitude_m, e_step, lambda_nm);
+    const double slope = t_step && e_step > e ? (*t_step - *t) / (e_step - e) : 0.0;
+    const double next = slope > 0.0 ? e - miss / slope : 0.5 * (lo + hi);
+    e = next > lo && next < hi ? next : 0.5 * (lo + hi);
   }
-  return 0.5 * (lo + hi);
+  return e;
 }
 
 double AtmosphereRefraction::solid_angle_ratio(double altitude_m, double apparent_deg, double lambda_nm) const {

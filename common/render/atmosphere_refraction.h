@@ -30,7 +30,7 @@
 // RefractionTable at altitude nodes (dense near the ground, where the dip of
 // the horizon grows fastest), 6 wavelength nodes (interpolated in 1/lambda^2),
 // linear in h between nodes.  true_elevation(h, e) is that interpolation;
-// apparent_elevation is its inverse by bisection, so the two are exact
+// apparent_elevation is its inverse (safeguarded Newton), so the two are exact
 // inverses of each other, which the MIS between the sun's samples and the
 // phase function's needs (the pdfs of both techniques share
 // solid_angle_ratio).  A source is hidden where either node hides it.
