@@ -846,7 +846,7 @@ void read_atmosphere(const Fields& top, AtmosphereSpec& out) {
   if (!v || !expect_object(*v, top.path_of("atmosphere"), e)) return;
   Fields f(*v, top.path_of("atmosphere"), e);
   f.allow_only({"preset", "ozone_du", "aerosol", "ground_albedo", "ground", "planet_radius_m", "top_altitude_m",
-                "constituents"});
+                "constituents", "refraction"});
   const bool preset_ok = !f.find("preset") || f.choice("preset", kPresets, out.preset);
   const bool custom = preset_ok && out.preset == AtmospherePreset::kCustom;
   const bool earth = preset_ok && !custom;
@@ -866,6 +866,7 @@ void read_atmosphere(const Fields& top, AtmosphereSpec& out) {
   read_ground(f, out);
   f.number("planet_radius_m", Range::closed(1e5, 1e8), out.planet_radius_m);
   f.number("top_altitude_m", Range::closed(1e3, 1e7), out.top_altitude_m);
+  f.boolean("refraction", out.refraction);
 
   const std::string cpath = f.path_of("constituents");
   if (const Json* c = f.find("constituents")) {
@@ -936,6 +937,8 @@ Json atmosphere_json(const AtmosphereSpec& a) {
     j["ozone_du"] = canonical_number(a.ozone_du);
     j["aerosol"] = a.aerosol ? aerosol_json(*a.aerosol) : Json(nullptr);
   }
+  // Written only when on, like "ground": requests without it keep their text.
+  if (a.refraction) j["refraction"] = true;
   return j;
 }
 

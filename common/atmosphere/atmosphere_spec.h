@@ -100,6 +100,9 @@ struct AtmosphereSpec {
   double planet_radius_m = 6371000.0;
   double top_altitude_m = 100000.0;
   std::vector<ConstituentSpec> constituents;  // custom preset only
+  // "atmosphere.refraction": rays bend in the air (Ciddor's index of US76,
+  // docs/physics.md, "Refraction"); off, the renderers trace straight rays.
+  bool refraction = false;
 };
 
 }  // namespace skyfarm

@@ -55,6 +55,10 @@ struct RefractedRay {
 
 RefractedRay trace_refracted_ray(const RefractiveShells& shells, double observer_radius_m, double zenith_deg,
                                  bool record_path = true);
+// The same into *result, whose path's storage is reused (the path tracer
+// traces a ray per segment and per shadow ray).
+void trace_refracted_ray(const RefractiveShells& shells, double observer_radius_m, double zenith_deg,
+                         bool record_path, RefractedRay* result);
 
 // The ray's plane in planet-centred coordinates: up is the unit vector from the
 // centre to the observer, forward the unit horizontal direction of the ray at

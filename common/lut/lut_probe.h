@@ -15,10 +15,12 @@
 namespace skyfarm {
 
 // radiance[d][w], W m^-2 sr^-1 nm^-1; directions are unit vectors in the
-// observer frame (z up, y north, x east).
+// observer frame (z up, y north, x east).  refraction: the sky seen
+// through it (LutSky::refracted).
 std::vector<std::vector<double>> probe_radiance_lut(const Atmosphere& atmosphere, const Sun& sun,
                                                     double observer_altitude_m,
                                                     const std::vector<glm::dvec3>& directions,
-                                                    const std::vector<double>& wavelengths_nm);
+                                                    const std::vector<double>& wavelengths_nm,
+                                                    bool refraction = false);
 
 }  // namespace skyfarm

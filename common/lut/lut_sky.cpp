@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 #include <limits>
 
+#include "common/core/constants.h"
 #include "common/geometry/sphere_intersection.h"
 #include "common/lut/aerial_perspective_lut.h"
 #include "common/lut/ground_irradiance_lut.h"
@@ -121,12 +122,50 @@ void LutSky::radiance(const glm::dvec3& view_dir, std::span<double> out, bool in
     raymarch_radiance({0.0, 0.0, observer_r_}, v, out, include_sun_disk, resolution_.space_view_steps);
     return;
   }
+  if (refraction_) {
+    refracted_radiance(v, out, include_sun_disk);
+    return;
+  }
   sky_view_->lookup(v.z, cos_relative_azimuth(v, sun_->direction()), out.data());
   if (include_sun_disk && sun_->contains(v)) {
     std::array<double, kMaxBins> T;
     t.transmittance.to_top(observer_r_, v.z, T.data());  // 0 where the planet hides it
     for (int b = 0; b < B; ++b)
       out[static_cast<std::size_t>(b)] += sun_L_[static_cast<std::size_t>(b)] * T[static_cast<std::size_t>(b)];
+  }
+  sanitize(out.first(static_cast<std::size_t>(B)));
+}
+
+std::optional<RefractedView::Apparent> LutSky::disk_sample_direction(const glm::dvec3& d) const {
+  if (!refraction_) return RefractedView::Apparent{d, 1.0};
+  return refraction_->apparent_direction(d, 550.0);
+}
+
+LutSky LutSky::refracted() const {
+  LutSky sky = *this;
+  if (!above_)
+    sky.refraction_ = std::make_shared<const RefractedView>(observer_altitude_m_, planet_radius_m(),
+                                                            tables_->medium.top_radius_m() - planet_radius_m());
+  return sky;
+}
+
+// radiance() through refracted_view.h: the sky at its mapped direction, the
+// disk bin by bin where the view's true direction at the bin's centre
+// wavelength lies in it (only views within a degree of the sun are mapped).
+void LutSky::refracted_radiance(const glm::dvec3& v, std::span<double> out, bool include_sun_disk) const {
+  const Tables& t = *tables_;
+  const int B = t.grid.size();
+  const glm::dvec3 sky = refraction_->sky_direction(v);
+  sky_view_->lookup(sky.z, cos_relative_azimuth(sky, sun_->direction()), out.data());
+  const double near_sun = std::cos(sun_->angular_radius_rad() + 1.0 * kDegToRad);
+  if (include_sun_disk && !sun_->is_point() && glm::dot(v, sun_->direction()) > near_sun) {
+    std::array<double, kMaxBins> T;
+    t.transmittance.to_top(observer_r_, v.z, T.data());  // 0 where the planet hides it
+    for (int b = 0; b < B; ++b) {
+      const auto seen = refraction_->true_direction(v, t.grid.centre_nm(b));
+      if (seen && sun_->contains(*seen))
+        out[static_cast<std::size_t>(b)] += sun_L_[static_cast<std::size_t>(b)] * T[static_cast<std::size_t>(b)];
+    }
   }
   sanitize(out.first(static_cast<std::size_t>(B)));
 }

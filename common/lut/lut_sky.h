@@ -85,10 +85,12 @@
 #include <cstdint>
 #include <glm/vec3.hpp>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include "common/atmosphere/atmosphere.h"
+#include "common/lut/refracted_view.h"
 #include "common/lut/spectral_grid.h"
 #include "common/sun/sun.h"
 
@@ -128,6 +130,15 @@ class LutSky {
   // observer altitude: only the sky-view and aerial-perspective tables are built.
   LutSky with_sun(const Sun& sun) const { return with_sun(sun, observer_altitude_m_); }
   LutSky with_sun(const Sun& sun, double observer_altitude_m) const;
+  // The same sky seen through refraction ("atmosphere.refraction",
+  // refracted_view.h: the look-up's directions mapped, the tables shared).
+  LutSky refracted() const;
+  // Where the sun's light from the true direction d shows in radiance() (d
+  // itself without refraction, its apparent direction at 550 nm with), and
+  // the solid angle ratio there (1, or dw_apparent / dw_true): a splat of
+  // the disk samples the true disk and puts each sample there, its solid
+  // angle times the ratio.  nullopt where the planet hides it.
+  std::optional<RefractedView::Apparent> disk_sample_direction(const glm::dvec3& d) const;
 
   const SpectralGrid& grid() const;
   // E_sun and the disk's radiance per bin (bin means).
@@ -176,12 +187,14 @@ class LutSky {
   void march(const glm::dvec3& origin, const glm::dvec3& dir, double t_max, int steps, bool ground, bool sun_disk,
              double* L, double* T) const;
   void sanitize(std::span<double> values) const;
+  void refracted_radiance(const glm::dvec3& v, std::span<double> out, bool include_sun_disk) const;
 
   std::shared_ptr<const Tables> tables_;
   std::shared_ptr<const SkyViewLut> sky_view_;          // null above the atmosphere
   std::shared_ptr<const AerialPerspectiveLut> aerial_;  // null above the atmosphere
   std::shared_ptr<std::atomic<std::uint64_t>> sanitized_;
   std::shared_ptr<const Sun> sun_;
+  std::shared_ptr<const RefractedView> refraction_;  // null: straight rays
   LutResolution resolution_;
   std::vector<double> sun_E_, sun_L_;
   double observer_altitude_m_ = 0.0, observer_r_ = 0.0;

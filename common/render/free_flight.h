@@ -39,9 +39,11 @@ namespace skyfarm {
 // (a ShellTraversal, or the replay of a RecordedShellWalk when the segments
 // were already walked for majorant_optical_depth), with the majorants of the
 // path's wavelengths from `majorants` (PathMajorants: path_majorants.h).
-template <class Walk, class Majorants, class Callback>
+// `ray` is anything with at(t): a Ray, or a bent path's walk (bent_path.h),
+// whose at(t) lies on the chord it walks.
+template <class Walk, class Majorants, class Callback, class Line>
 SampledSpectrum sample_t_maj_along(Walk& walk, const Majorants& majorants, const AtmosphereMedium& medium,
-                                   const Ray& ray, const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
+                                   const Line& ray, const PathCoefficients& path, Sampler& sampler, MediumPoint& point,
                                    Callback&& callback, double majorant_scale = 1.0, double forced_tau = 0.0) {
   const double R = medium.atmosphere().planet_radius_m();
   SampledSpectrum tau_maj(0.0);  // majorant optical depth since the last collision

@@ -43,7 +43,7 @@ ProbeAnswer answer_probe(const ProbeSpec& spec, int threads) {
   const Scene scene = probe_scene(spec);
   if (spec.lut)
     return ProbeAnswer{probe_radiance_lut(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),
-                                          spec.directions, spec.wavelengths_nm),
+                                          spec.directions, spec.wavelengths_nm, scene.refraction() != nullptr),
                        std::nullopt, 0, scene.sun().zenith_deg(), scene.sun().azimuth_deg()};
   const ProbeResult r = probe_radiance(scene, spec.directions, spec.wavelengths_nm, probe_plan(spec), spec.seed,
                                        threads, probe_roulette_control(spec, scene));

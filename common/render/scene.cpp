@@ -21,6 +21,8 @@ Scene Scene::from_specs(const AtmosphereSpec& atmosphere, const SunSpec& sun, co
     // A Lambertian material is all its albedo: the atmosphere's ground already is it.
     if (!surface->lambertian()) scene.ground_surface_ = std::move(surface);
   }
+  if (atmosphere.refraction)
+    scene.refraction_ = AtmosphereRefraction::shared(atmosphere.planet_radius_m, atmosphere.top_altitude_m);
   return scene;
 }
 

@@ -14,6 +14,8 @@
 //   environment_radiance  uniform radiance arriving from beyond the atmosphere,
 //                         W m^-2 sr^-1 nm^-1 (0 in real skies; the furnace tests use it)
 //   sun_enabled           false removes the sun (furnace tests)
+//   refraction            rays bend in the air (atmosphere_refraction.h),
+//                         or null: straight rays, and none of the cost
 #pragma once
 #include <memory>
 #include <optional>
@@ -25,6 +27,7 @@
 #include "common/clouds/scene_clouds.h"
 #include "common/material/surface.h"
 #include "common/render/atmosphere_medium.h"
+#include "common/render/atmosphere_refraction.h"
 #include "common/render/scene_objects.h"
 #include "common/sun/sun.h"
 
@@ -47,6 +50,9 @@ class Scene {
   // The clouds in the scene, or null.
   const SceneClouds* clouds() const { return clouds_.get(); }
   void set_clouds(std::shared_ptr<const SceneClouds> clouds) { clouds_ = std::move(clouds); }
+  // The bending of rays in the air ("atmosphere.refraction"), or null.
+  const AtmosphereRefraction* refraction() const { return refraction_.get(); }
+  void set_refraction(std::shared_ptr<const AtmosphereRefraction> refraction) { refraction_ = std::move(refraction); }
   // Planet-centred observer position (0, 0, R + altitude).
   glm::dvec3 observer() const { return observer_; }
   double observer_altitude_m() const { return observer_.z - atmosphere_->planet_radius_m(); }
@@ -62,6 +68,7 @@ class Scene {
   std::shared_ptr<const material::Surface> ground_surface_;
   std::shared_ptr<const SceneObjects> objects_;
   std::shared_ptr<const SceneClouds> clouds_;
+  std::shared_ptr<const AtmosphereRefraction> refraction_;
   Sun sun_;
   glm::dvec3 observer_;
   double lambda_min_, lambda_max_;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/camera/camera.h"
+#include "common/render/atmosphere_refraction.h"
 #include "common/sun/sun.h"
 
 namespace skyfarm {
@@ -16,5 +17,11 @@ namespace skyfarm {
 // disk's angular radius plus two pixel widths of the sun's centre (empty when
 // the sun is a point or out of view).
 std::vector<std::uint32_t> sun_pixels(const Camera& camera, const Sun& sun);
+// The same for the sun seen through refraction (null: straight) from the
+// planet-centred observer: around its apparent centre at 550 nm (empty when
+// hidden), widened by the rims' dispersion.  The server and the worker both
+// call this one, so their sample allocations agree.
+std::vector<std::uint32_t> sun_pixels(const Camera& camera, const Sun& sun, const AtmosphereRefraction* refraction,
+                                      const glm::dvec3& observer);
 
 }  // namespace skyfarm

@@ -31,16 +31,18 @@ IntegratorOptions with_plan_tables(const Scene& scene, const RenderPlan& plan, I
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
                            IntegratorOptions options)
     : scene_(scene), camera_(camera), plan_(plan), integrator_(scene, with_plan_tables(scene, plan, options)),
-      sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())) {
-  if (plan_.lut)
-    lut_ = std::make_shared<const LutSky>(LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(),
-                                                        plan_.lambda_min_nm, plan_.lambda_max_nm));
+      sun_pixels_(skyfarm::sun_pixels(camera, scene.sun(), scene.refraction(), scene.observer())) {
+  if (plan_.lut) {
+    LutSky sky = LutSky::build(scene.atmosphere(), scene.sun(), scene.observer_altitude_m(), plan_.lambda_min_nm,
+                               plan_.lambda_max_nm);
+    lut_ = std::make_shared<const LutSky>(scene.refraction() ? sky.refracted() : std::move(sky));
+  }
   build_lut_clouds({});
 }
 
 TileRenderer::TileRenderer(const Scene& scene, const Camera& camera, const RenderPlan& plan,
                            std::shared_ptr<const LutSky> lut, const CloudMarchOptions& clouds)
-    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun())),
+    : scene_(scene), camera_(camera), plan_(plan), integrator_(scene), sun_pixels_(skyfarm::sun_pixels(camera, scene.sun(), scene.refraction(), scene.observer())),
       lut_(std::move(lut)) {
   plan_.lut = true;
   build_lut_clouds(clouds);

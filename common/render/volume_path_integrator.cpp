@@ -212,27 +212,46 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
   // vertices keep their NEE with MIS.
   MediumPoint mp;
 
+  // With refraction, each segment outside solids is a bent path (bent_path.h):
+  // its flight walks the chords, and finish_segment gets the straight ray
+  // that carries the path's end (tail, tail_extent).
+  const AtmosphereRefraction* refraction = scene_.refraction();
+  BentPath bent_path;
+
   for (;; ++depth) {
-    const RadialRay radial = radial_ray(ray);
-    RayExtent extent = ray_extent(radial, atmosphere);
-    if (scene_.objects() && extent.in_atmosphere) {
-      if ((extent.object = scene_.objects()->intersect(ray, extent.t_end))) {
-        extent.t_end = extent.object->t;
-        extent.hits_ground = false;
+    const bool bent = refraction && !st.in_solid;
+    RayExtent extent;
+    RadialRay radial{};
+    if (bent) {
+      extent = bent_extent(ray, c, &bent_path);
+      if (bent_path.outcome == RefractedRay::Outcome::kTrapped) return L;  // circling in a duct: no light out
+    } else {
+      radial = radial_ray(ray);
+      extent = ray_extent(radial, atmosphere);
+      if (scene_.objects() && extent.in_atmosphere) {
+        if ((extent.object = scene_.objects()->intersect(ray, extent.t_end))) {
+          extent.t_end = extent.object->t;
+          extent.hits_ground = false;
+        }
+      }
+      // The clouds' first real collision on the segment (delta tracking in the
+      // clouds alone, scene_clouds.h): the air's tracking below then runs up
+      // to it, and the nearer of the two media's collisions is the sum's.
+      if (scene_.clouds() && extent.in_atmosphere && !st.in_solid && extent.t_end > extent.t_begin) {
+        if (const auto hit =
+                scene_.clouds()->sample_collision(ray, extent.t_begin, extent.t_end, sampler, &counters->collisions)) {
+          extent.t_end = hit->t;
+          extent.hits_ground = false;
+          extent.object.reset();
+          extent.cloud = hit->field;
+        }
       }
     }
-    // The clouds' first real collision on the segment (delta tracking in the
-    // clouds alone, scene_clouds.h): the air's tracking below then runs up
-    // to it, and the nearer of the two media's collisions is the sum's.
-    if (scene_.clouds() && extent.in_atmosphere && !st.in_solid && extent.t_end > extent.t_begin) {
-      if (const auto hit =
-              scene_.clouds()->sample_collision(ray, extent.t_begin, extent.t_end, sampler, &counters->collisions)) {
-        extent.t_end = hit->t;
-        extent.hits_ground = false;
-        extent.object.reset();
-        extent.cloud = hit->field;
-      }
-    }
+    // The straight ray and extent finish_segment sees: the segment's own, or
+    // the chord where the bent path ends (its exit direction if it escapes).
+    Ray tail = ray;
+    RayExtent tail_extent = extent;
+    if (bent) bent_tail(bent_path, extent, &tail, &tail_extent);
     if (st.in_solid) {
       // Inside a solid object: straight to its surface, nothing in between.
       // A ray that misses it has slipped out through round-off: lost.
@@ -244,7 +263,9 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
     // on segments the planet's shadow cuts or that start with the sun below
     // their local horizontal (or on every one if asked).
     bool explicit_single = false;
-    if (scene_.sun_enabled && extent.in_atmosphere && extent.t_end > extent.t_begin &&
+    // (Not on bent paths: its lit intervals and sun rays are straight lines;
+    // the NEE at the collisions gathers that light instead.)
+    if (scene_.sun_enabled && !bent && extent.in_atmosphere && extent.t_end > extent.t_begin &&
         (options_.explicit_single_scattering || options_.sunlit_segments_in_shadow)) {
       const SunlitIntervals lit = sunlit_intervals(ray, extent.t_begin, extent.t_end, scene_.sun().direction(),
                                                    atmosphere.planet_radius_m());
@@ -265,11 +286,18 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       // shell crossings are recorded and replayed.
       const bool forced = depth < options_.forced_collision_segments;
       const ShellMajorants& shells = medium.fine_shells();
-      const ShellTraversal walk(ray, radial, atmosphere.planet_radius_m(), shells.bottoms, extent.t_begin,
-                                extent.t_end);
+      const ShellTraversal walk = bent ? ShellTraversal()
+                                       : ShellTraversal(ray, radial, atmosphere.planet_radius_m(), shells.bottoms,
+                                                        extent.t_begin, extent.t_end);
+      std::optional<BentShellWalk> bent_walk;
+      if (bent)
+        bent_walk.emplace(bent_path, atmosphere.planet_radius_m(), shells.bottoms, extent.t_begin, extent.t_end);
       RecordedShellWalk record;
       SampledSpectrum tau_maj(0.0);
-      if (depth == 0 || forced) {
+      if (bent && (depth == 0 || forced)) {
+        BentShellWalk again = *bent_walk;
+        tau_maj = majorant_optical_depth_along(again, c.fine);
+      } else if (depth == 0 || forced) {
         record.record(walk);
         RecordedShellWalk::Replay replay = record.replay();
         tau_maj = majorant_optical_depth_along(replay, c.fine);
@@ -291,8 +319,9 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         PathState none = st;
         none.beta *= exp_neg(tau);
         none.r_l *= exp_neg(tau);
-        Ray next = ray;
-        if (finish_segment(extent, c, depth, &next, &none, &L)) L += trace(next, none, depth + 1, c);
+        Ray next = tail;
+        if (bent) none.sun_pdf_scale = sun_pdf_scale(ray, bent_path, tail_extent, c);
+        if (finish_segment(tail_extent, c, depth, &next, &none, &L)) L += trace(next, none, depth + 1, c);
         SampledSpectrum p_some;
         for (int i = 0; i < kWavelengthsPerPath; ++i) p_some[i] = -std::expm1(-tau[i]);
         if (!(p_some[0] > 0.0)) return L;
@@ -313,7 +342,8 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
           const SampledSpectrum beta_s = st.beta * T_maj_seg * mp.sigma_s * (1.0 / pdf);
           const SampledSpectrum r_u_s = st.r_u * T_maj_seg * mp.sigma_s * (1.0 / pdf);
           if (!beta_s.is_zero() && !r_u_s.is_zero()) {
-            Vertex v{p, ray.d, false, {}, &mp, &phases, &path, &c.coarse, beta_s * p_scatter, r_u_s};
+            Vertex v{p, bent_walk ? bent_walk->direction() : ray.d, false, {}, &mp, &phases, &path, &c.coarse,
+                     beta_s * p_scatter, r_u_s};
             L += sample_sun(v, c.lambda, sampler, counters);
           }
         }
@@ -331,6 +361,7 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
             absorbed = true;
             return false;
           }
+          if (bent_walk) ray.d = bent_walk->direction();  // the direction it arrived along
           scattered = scatter_in_medium(p, mp, phases, sampler, &ray, &st);
           absorbed = !scattered;
           return false;
@@ -351,7 +382,10 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
         return sample_t_maj_along(segments, c.fine, medium, ray, path, sampler, mp, collide, scale, forced_tau);
       };
       SampledSpectrum T_maj;
-      if (record.recorded()) {
+      if (bent_walk) {
+        BentShellWalk& segments = *bent_walk;
+        T_maj = sample_t_maj_along(segments, c.fine, medium, segments, path, sampler, mp, collide, scale, forced_tau);
+      } else if (record.recorded()) {
         RecordedShellWalk::Replay replay = record.replay();
         T_maj = fly(replay);
       } else {
@@ -367,7 +401,9 @@ SampledSpectrum VolumePathIntegrator::trace(Ray ray, PathState st, int depth, co
       }
     }
     if (!scattered) {
-      if (!finish_segment(extent, c, depth, &ray, &st, &L)) return L;
+      if (bent) st.sun_pdf_scale = sun_pdf_scale(ray, bent_path, tail_extent, c);
+      ray = tail;
+      if (!finish_segment(tail_extent, c, depth, &ray, &st, &L)) return L;
       continue;
     }
     st.mis_with_sun = scene_.sun_enabled && !scene_.sun().is_point();
@@ -469,6 +505,71 @@ bool VolumePathIntegrator::scatter_in_medium(const glm::dvec3& p, const MediumPo
   return true;
 }
 
+// Objects and clouds are met chord after chord, in order: the first object
+// hit, then the clouds' first collision before it (delta tracking in the
+// clouds is memoryless, so sampling it chord by chord is sampling it along
+// the whole path).
+RayExtent VolumePathIntegrator::bent_extent(const Ray& ray, const PathContext& c, BentPath* path) const {
+  scene_.refraction()->trace(ray.o, ray.d, c.lambda.lambda_nm[0], path);
+  RayExtent e;
+  e.in_atmosphere = path->in_atmosphere;
+  if (!e.in_atmosphere) return e;
+  e.t_begin = path->t_enter;
+  e.t_end = path->t_end;
+  e.hits_ground = path->outcome == RefractedRay::Outcome::kHitGround;
+  if (scene_.objects()) {
+    for (const Chord& chord : path->chords) {
+      if (chord.t0 >= e.t_end) break;
+      if (auto hit = scene_.objects()->intersect(chord.ray(), chord.length)) {
+        e.t_end = chord.t0 + hit->t;
+        e.object = std::move(hit);
+        e.hits_ground = false;
+        break;
+      }
+    }
+  }
+  if (scene_.clouds()) {
+    for (const Chord& chord : path->chords) {
+      const double a = std::max(0.0, e.t_begin - chord.t0), b = std::min(chord.length, e.t_end - chord.t0);
+      if (chord.t0 >= e.t_end) break;
+      if (!(b > a)) continue;
+      if (const auto hit = scene_.clouds()->sample_collision(chord.ray(), a, b, c.sampler, &c.counters->collisions)) {
+        e.t_end = chord.t0 + hit->t;
+        e.hits_ground = false;
+        e.object.reset();
+        e.cloud = hit->field;
+        break;
+      }
+    }
+  }
+  return e;
+}
+
+void VolumePathIntegrator::bent_tail(const BentPath& path, const RayExtent& extent, Ray* tail,
+                                     RayExtent* tail_extent) {
+  *tail_extent = extent;
+  if (!path.in_atmosphere) {
+    *tail = Ray{path.start, path.exit_direction};
+    return;
+  }
+  double local_t = 0.0;
+  *tail = path.ray_at(extent.t_end, &local_t);
+  tail_extent->t_begin = 0.0;
+  tail_extent->t_end = local_t;
+  // Out through the top: on into space along the exit direction, the true
+  // direction of whatever it sees (the sun disk, the environment).
+  if (!extent.hits_ground && !extent.object && !extent.cloud) *tail = Ray{tail->at(local_t), path.exit_direction};
+}
+
+// Only a path that escapes into the sun disk needs it (finish_segment's MIS).
+double VolumePathIntegrator::sun_pdf_scale(const Ray& ray, const BentPath& path, const RayExtent& tail_extent,
+                                           const PathContext& c) const {
+  if (!scene_.sun_enabled || tail_extent.hits_ground || tail_extent.object || tail_extent.cloud) return 1.0;
+  if (!scene_.sun().contains(path.exit_direction)) return 1.0;
+  const double ratio = scene_.refraction()->solid_angle_ratio_at(ray.o, ray.d, c.lambda.lambda_nm[0]);
+  return ratio > 0.0 ? 1.0 / ratio : 1.0;
+}
+
 // The end of a segment the path crossed without scattering: space (the sun
 // disk, with MIS if the last vertex sampled it, and the environment; the
 // path ends: false) or the ground (sun NEE, then a cosine-weighted bounce:
@@ -497,7 +598,7 @@ bool VolumePathIntegrator::finish_segment(const RayExtent& extent, const PathCon
       if (!st->mis_with_sun) {
         *L += st->beta * Le * (1.0 / st->r_u.average());
       } else {
-        const SampledSpectrum r_l = st->r_l * sun.pdf(ray->d);
+        const SampledSpectrum r_l = st->r_l * (sun.pdf(ray->d) * st->sun_pdf_scale);
         if (st->mis_power)
           *L += st->beta * Le * power_weight(st->r_u.average(), r_l.average());
         else
@@ -578,10 +679,18 @@ bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::
     const double w_A = st->sun_lobe_depth == depth ? st->sun_lobe_weight : 1.0;
     *L += sample_sun(v, c.lambda, c.sampler, c.counters) * w_A;
   }
-  const glm::dvec3& s = scene_.sun().direction();
-  const bool lobe = options_.cloud_sun_lobe && scene_.sun_enabled &&
-                    ground_distance(radial_ray(Ray{p, s}), scene_.atmosphere().planet_radius_m()) < 0.0;
-  if (lobe) *L += sun_lobe_estimate(optics.phase, p, wo, *st, c);
+  // The lobe's axis: the sun's direction, or with refraction its apparent
+  // direction at p (where the cloud's diffraction peak meets the sun's light).
+  glm::dvec3 s = scene_.sun().direction();
+  bool lobe = options_.cloud_sun_lobe && scene_.sun_enabled;
+  if (lobe && scene_.refraction()) {
+    const auto apparent = scene_.refraction()->apparent_direction(p, s, c.lambda.lambda_nm[0]);
+    lobe = apparent.has_value();
+    if (apparent) s = apparent->direction;
+  } else if (lobe) {
+    lobe = ground_distance(radial_ray(Ray{p, s}), scene_.atmosphere().planet_radius_m()) < 0.0;
+  }
+  if (lobe) *L += sun_lobe_estimate(optics.phase, s, p, wo, *st, c);
   const glm::dvec3 wi = optics.phase.sample_direction(wo, c.sampler.next(), c.sampler.next());
   const double pdf = optics.phase.eval(clamp_cos(glm::dot(wo, wi)));
   if (!(pdf > 0.0)) return false;
@@ -605,10 +714,14 @@ bool VolumePathIntegrator::scatter_in_cloud(const CloudField& cloud, const glm::
 // as a shadow ray's do in sample_sun) and the NEE there: the path's
 // throughput times p(wo.wi) / q(wi) (the direction's importance weight)
 // times the balance weight q / (p + q), that is beta p / (p + q).
-SampledSpectrum VolumePathIntegrator::sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& p,
-                                                        const glm::dvec3& wo, const PathState& st,
-                                                        const PathContext& c) const {
-  const glm::dvec3& s = scene_.sun().direction();
+//
+// With refraction the hop from p to the next cloud collision stays straight
+// (over the few km between cloud vertices a ray strays < 1 m from its
+// chord), while the path's own next segment is bent: the two techniques'
+// transport differs by that much.
+SampledSpectrum VolumePathIntegrator::sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& s,
+                                                        const glm::dvec3& p, const glm::dvec3& wo,
+                                                        const PathState& st, const PathContext& c) const {
   const glm::dvec3 wi = phase.sample_direction(s, c.sampler.next(), c.sampler.next());
   const double q = phase.eval(clamp_cos(glm::dot(s, wi)));
   const double p_wo = phase.eval(clamp_cos(glm::dot(wo, wi)));
@@ -830,13 +943,28 @@ bool VolumePathIntegrator::residual_tracking_pays(const glm::dvec3& p, const glm
 //   L_d = beta f T L_sun / avg_i(r_p,i (pdf_light r_l,ray,i + pdf_scatter,i r_u,ray,i)),
 // balance heuristic between sampling the sun and sampling the phase/BRDF
 // (for a point sun only the former exists).
-SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledWavelengths&, Sampler& sampler,
+//
+// With refraction the sun's sample is a true direction on the disk; the
+// light leaves p along its apparent direction (atmosphere_refraction.h, at
+// the hero wavelength), and the shadow ray follows the bent path from there
+// (ratio tracking through the coarse shells chord by chord; residual
+// tracking's control is built for straight rays).  The sun's pdf over the
+// apparent directions is its pdf over the true ones over dw_apparent /
+// dw_true (finish_segment's sun_pdf_scale, the other side of the MIS).
+SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
                                                  PathCounters* counters) const {
   const Sun& sun = scene_.sun();
   const Atmosphere& atmosphere = scene_.atmosphere();
+  const AtmosphereRefraction* refraction = scene_.refraction();
   const double u1 = sampler.next(), u2 = sampler.next();
   double pdf_light = 0.0;
-  const glm::dvec3 wi = sun.sample_direction(u1, u2, &pdf_light);
+  glm::dvec3 wi = sun.sample_direction(u1, u2, &pdf_light);
+  if (refraction) {
+    const auto apparent = refraction->apparent_direction(v.p, wi, lambda.lambda_nm[0]);
+    if (!apparent) return SampledSpectrum(0.0);  // the planet hides it
+    wi = apparent->direction;
+    pdf_light /= apparent->solid_angle_ratio;
+  }
 
   // Scattering value f and its sampling pdf for each wavelength.
   SampledSpectrum f, pdf_scatter;
@@ -865,6 +993,8 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     pdf_scatter = direction_pdf(v.p, wi, f, table, table ? std::nullopt : twilight_guide(v.p));
   }
   if (f.is_zero()) return SampledSpectrum(0.0);
+
+  if (refraction) return sample_sun_bent(v, wi, pdf_light, f, pdf_scatter, lambda, sampler, counters);
 
   // Shadow ray: blocked by the planet, else ratio tracking to the top.
   const Ray shadow{v.p, wi};
@@ -925,6 +1055,69 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
     r_u_ray *= T_maj * (1.0 / T0);
   }
 
+  const SampledSpectrum& Le = v.path->sun_radiance;
+  const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
+  const SampledSpectrum Ld = v.beta * f * T_ray * Le;
+  if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
+    return Ld * (1.0 / r_l.average());
+  const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
+  if (v.surface && options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower)
+    return Ld * power_weight(r_l.average(), r_u.average());
+  return Ld * (1.0 / (r_l + r_u).average());
+}
+
+// The bent shadow ray of sample_sun towards the apparent direction wi.
+SampledSpectrum VolumePathIntegrator::sample_sun_bent(const Vertex& v, const glm::dvec3& wi, double pdf_light,
+                                                      const SampledSpectrum& f, const SampledSpectrum& pdf_scatter,
+                                                      const SampledWavelengths& lambda, Sampler& sampler,
+                                                      PathCounters* counters) const {
+  const Sun& sun = scene_.sun();
+  const AtmosphereMedium& medium = scene_.medium();
+  thread_local BentPath path;
+  scene_.refraction()->trace(v.p, wi, lambda.lambda_nm[0], &path);
+  if (path.outcome != RefractedRay::Outcome::kEscaped) return SampledSpectrum(0.0);
+  if (scene_.objects())
+    for (const Chord& chord : path.chords)
+      if (scene_.objects()->occluded(chord.ray(), chord.length)) return SampledSpectrum(0.0);
+  double T_clouds = 1.0;
+  if (scene_.clouds()) {
+    for (const Chord& chord : path.chords) {
+      T_clouds *= scene_.clouds()->transmittance(chord.ray(), 0.0, chord.length, sampler, &counters->collisions);
+      if (!(T_clouds > 0.0)) return SampledSpectrum(0.0);
+    }
+  }
+  SampledSpectrum T_ray(T_clouds), r_u_ray(1.0), r_l_ray(1.0);
+  if (path.in_atmosphere) {
+    MediumPoint mp;
+    BentShellWalk walk(path, scene_.atmosphere().planet_radius_m(), medium.coarse_shells().bottoms, path.t_enter,
+                       path.t_end);
+    const SampledSpectrum T_maj = sample_t_maj_along(
+        walk, *v.shadow_majorants, medium, walk, *v.path, sampler, mp,
+        [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
+          ++counters->collisions;
+          const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+          const double pdf = T_maj_seg[0] * sigma_maj[0];
+          T_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+          r_l_ray *= T_maj_seg * sigma_maj * (1.0 / pdf);
+          r_u_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+          // Russian roulette once the MIS-weighted transmittance is small.
+          const SampledSpectrum Tr = T_ray * (1.0 / (r_l_ray + r_u_ray).average());
+          if (Tr.max() < 0.05) {
+            const double q = 0.75;
+            if (sampler.next() < q)
+              T_ray = SampledSpectrum(0.0);
+            else
+              T_ray *= 1.0 / (1.0 - q);
+          }
+          return !T_ray.is_zero();
+        },
+        options_.shadow_majorant_scale);
+    if (T_ray.is_zero()) return SampledSpectrum(0.0);
+    const double T0 = T_maj[0];
+    T_ray *= T_maj * (1.0 / T0);
+    r_l_ray *= T_maj * (1.0 / T0);
+    r_u_ray *= T_maj * (1.0 / T0);
+  }
   const SampledSpectrum& Le = v.path->sun_radiance;
   const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
   const SampledSpectrum Ld = v.beta * f * T_ray * Le;

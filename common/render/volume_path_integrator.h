@@ -51,6 +51,7 @@
 
 #include "common/geometry/ray.h"
 #include "common/render/atmosphere_medium.h"
+#include "common/render/bent_path.h"
 #include "common/render/residual_ratio_tracking.h"
 #include "common/render/scene.h"
 #include "common/render/sunlit_intervals.h"
@@ -247,6 +248,10 @@ class VolumePathIntegrator {
     // a cloud collision at depth sun_lobe_depth (scatter_in_cloud).
     double sun_lobe_weight = 1.0;
     int sun_lobe_depth = -1;
+    // With refraction: the sun's pdf over the directions at the segment's
+    // start (apparent) over its pdf over the true directions it arrives
+    // from, dw_true / dw_apparent (atmosphere_refraction.h); 1 without.
+    double sun_pdf_scale = 1.0;
   };
   // What stays fixed along one path.
   struct PathContext {
@@ -273,8 +278,19 @@ class VolumePathIntegrator {
                         PathState* st, SampledSpectrum* L) const;
   // The sun lobe's estimate from the cloud vertex at p (arrived along wo, the
   // phase function `phase`, the path's state st after the albedo).
-  SampledSpectrum sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& p, const glm::dvec3& wo,
-                                    const PathState& st, const PathContext& c) const;
+  // s: the lobe's axis (the sun's direction, or its apparent one at p).
+  SampledSpectrum sun_lobe_estimate(const PhaseFunction& phase, const glm::dvec3& s, const glm::dvec3& p,
+                                    const glm::dvec3& wo, const PathState& st, const PathContext& c) const;
+  // The extent of the bent path from ray.o along ray.d (traced into *path,
+  // at the hero wavelength): the air, and the first object or cloud
+  // collision met chord after chord.
+  RayExtent bent_extent(const Ray& ray, const PathContext& c, BentPath* path) const;
+  // The straight ray carrying the end of a bent path, and the extent in its
+  // own distance (finish_segment's arguments).
+  static void bent_tail(const BentPath& path, const RayExtent& extent, Ray* tail, RayExtent* tail_extent);
+  // PathState::sun_pdf_scale of the segment from ray.o along ray.d.
+  double sun_pdf_scale(const Ray& ray, const BentPath& path, const RayExtent& tail_extent,
+                       const PathContext& c) const;
   bool finish_segment(const RayExtent& extent, const PathContext& c, int depth, Ray* ray, PathState* st,
                       SampledSpectrum* L) const;
   // A surface that is a material (the ground's when it is not Lambertian, an
@@ -312,6 +328,11 @@ class VolumePathIntegrator {
   double camera_majorant_scale(double tau) const;
   SampledSpectrum sample_sun(const Vertex& v, const SampledWavelengths& lambda, Sampler& sampler,
                              PathCounters* counters) const;
+  // Its shadow ray and weights with refraction: the bent path from v.p
+  // along the apparent direction wi (pdf_light over the apparent directions).
+  SampledSpectrum sample_sun_bent(const Vertex& v, const glm::dvec3& wi, double pdf_light, const SampledSpectrum& f,
+                                  const SampledSpectrum& pdf_scatter, const SampledWavelengths& lambda,
+                                  Sampler& sampler, PathCounters* counters) const;
 
   const Scene& scene_;
   IntegratorOptions options_;

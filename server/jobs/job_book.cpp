@@ -38,7 +38,12 @@ Job& JobBook::add_job(JobRecord record, api::RenderRequest request) {
   {
     const Camera camera(request.camera,
                         {0.0, 0.0, request.atmosphere.planet_radius_m + request.location.altitude_m});
-    job->sun_pixels = sun_pixels(camera, sun);
+    const double observer_r = request.atmosphere.planet_radius_m + request.location.altitude_m;
+    const auto refraction = request.atmosphere.refraction
+                                ? AtmosphereRefraction::shared(request.atmosphere.planet_radius_m,
+                                                               request.atmosphere.top_altitude_m)
+                                : nullptr;
+    job->sun_pixels = sun_pixels(camera, sun, refraction.get(), {0.0, 0.0, observer_r});
     job->result_check = std::make_unique<UnitResultCheck>(job->plan, camera, job->sun_pixels);
   }
   job->dir = data_dir / "jobs" / record.id;

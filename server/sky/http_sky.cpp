@@ -33,7 +33,7 @@ constexpr int kMaxBins = 96;
 
 constexpr std::string_view kCommonParams[] = {"lat",     "lon",     "altitude", "time",    "sun_zenith",
                                               "sun_azimuth", "preset", "ozone_du", "aod",  "aerosol",
-                                              "albedo",  "min_nm",  "max_nm"};
+                                              "albedo",  "min_nm",  "max_nm", "refraction"};
 constexpr std::string_view kLookupParams[] = {"view_zenith", "view_azimuth"};
 constexpr std::string_view kEnvmapParams[] = {"width", "sun", "layout", "color_space", "units"};
 
@@ -53,6 +53,7 @@ constexpr PathName kFieldNames[] = {
     {"atmosphere.aerosol.optical_depth_550", "aod"},
     {"atmosphere.aerosol", "aod"},
     {"atmosphere.ground_albedo", "albedo"},
+    {"atmosphere.refraction", "refraction"},
     {"directions[0].zenith_deg", "view_zenith"},
     {"directions[0].azimuth_deg", "view_azimuth"},
     {"wavelengths_nm[0]", "min_nm"},
@@ -228,6 +229,10 @@ SkyQuery parse_sky_query(const QueryParams& params, SkyRoute route, int base_spe
   }
   if (aerosol && *aerosol == "none") atmosphere["aerosol"] = nullptr;
   q.number_into("albedo", atmosphere, "ground_albedo");
+  if (const auto refraction = q.text("refraction")) {
+    if (*refraction == "true" || *refraction == "false") atmosphere["refraction"] = *refraction == "true";
+    else q.error("refraction", "must be true or false", quote_value(*refraction));
+  }
   body["atmosphere"] = atmosphere;
 
   Json direction = {{"zenith_deg", 0.0}, {"azimuth_deg", 0.0}};

@@ -170,6 +170,7 @@ std::shared_ptr<const SkyTable> build_sky_table(const SkyTableParams& p) {
   const Atmosphere atmosphere = build_atmosphere(p.atmosphere);
   Sun sun = table_sun(p);
   LutSky sky = LutSky::build(atmosphere, sun, p.altitude_m, p.min_nm, p.max_nm, p.resolution);
+  if (p.atmosphere.refraction) sky = sky.refracted();
   return finish_table(p, std::move(sky), std::move(sun), start);
 }
 
@@ -177,6 +178,7 @@ std::shared_ptr<const SkyTable> sky_table_for_sun(const SkyTable& donor, const S
   const auto start = std::chrono::steady_clock::now();
   Sun sun = table_sun(p);
   LutSky sky = donor.sky.with_sun(sun, p.altitude_m);
+  if (p.atmosphere.refraction) sky = sky.refracted();
   return finish_table(p, std::move(sky), std::move(sun), start);
 }
 
@@ -190,9 +192,10 @@ SunDiskSummary sun_disk_summary(const SkyTable& table, int samples) {
   double pdf = 0.0;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const glm::dvec3 d = sun.sample_direction((i + 0.5) / n, (j + 0.5) / n, &pdf);
-      disk_radiance(table.sky, d, with, without);
-      for (std::size_t b = 0; b < B; ++b) sum[b] += with[b];
+      const auto seen = table.sky.disk_sample_direction(sun.sample_direction((i + 0.5) / n, (j + 0.5) / n, &pdf));
+      if (!seen) continue;
+      disk_radiance(table.sky, seen->direction, with, without);
+      for (std::size_t b = 0; b < B; ++b) sum[b] += with[b] * seen->solid_angle_ratio;
     }
   for (double& v : sum) v /= double(n) * double(n);
   s.xyz = table.xyz(sum);
@@ -240,7 +243,11 @@ Image render_envmap(const SkyTable& table, int width, EnvmapSun sun_mode, int th
     double pdf = 0.0;
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
-        const glm::dvec3 d = sun.sample_direction((i + 0.5) / n, (j + 0.5) / n, &pdf);
+        // With refraction each sample shows at its apparent place, its solid
+        // angle scaled (LutSky::disk_sample_direction).
+        const auto seen = sky.disk_sample_direction(sun.sample_direction((i + 0.5) / n, (j + 0.5) / n, &pdf));
+        if (!seen) continue;
+        const glm::dvec3 d = seen->direction;
         if (!camera.direction_to_film(d, &fx, &fy)) continue;
         const int px = std::clamp(static_cast<int>(fx), 0, width - 1);
         const int py = std::clamp(static_cast<int>(fy), 0, height - 1);
@@ -248,7 +255,7 @@ Image render_envmap(const SkyTable& table, int width, EnvmapSun sun_mode, int th
         auto& acc = splats[static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(width) +
                            static_cast<std::uint64_t>(px)];
         if (acc.empty()) acc.assign(B, 0.0);
-        for (std::size_t b = 0; b < B; ++b) acc[b] += with[b] * weight;
+        for (std::size_t b = 0; b < B; ++b) acc[b] += with[b] * weight * seen->solid_angle_ratio;
       }
     for (auto& [index, acc] : splats) {
       const int px = static_cast<int>(index % static_cast<std::uint64_t>(width));
@@ -302,7 +309,9 @@ Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun_m
     double pdf = 0.0;
     for (int i = 0; i < m; ++i)
       for (int j = 0; j < m; ++j) {
-        const glm::dvec3 d = sun.sample_direction((i + 0.5) / m, (j + 0.5) / m, &pdf);
+        const auto seen = sky.disk_sample_direction(sun.sample_direction((i + 0.5) / m, (j + 0.5) / m, &pdf));
+        if (!seen) continue;
+        const glm::dvec3 d = seen->direction;
         const glm::dvec2 p = equal_area_sphere_to_square(d);
         const int px = std::clamp(static_cast<int>(p.x * n), 0, n - 1);
         const int py = std::clamp(static_cast<int>(p.y * n), 0, n - 1);
@@ -310,7 +319,7 @@ Image render_envmap_equal_area(const SkyTable& table, int width, EnvmapSun sun_m
         auto& acc = splats[static_cast<std::uint64_t>(py) * static_cast<std::uint64_t>(n) +
                            static_cast<std::uint64_t>(px)];
         if (acc.empty()) acc.assign(B, 0.0);
-        for (std::size_t b = 0; b < B; ++b) acc[b] += with[b] * weight;
+        for (std::size_t b = 0; b < B; ++b) acc[b] += with[b] * weight * seen->solid_angle_ratio;
       }
     for (auto& [index, acc] : splats) {
       const int px = static_cast<int>(index % static_cast<std::uint64_t>(n));

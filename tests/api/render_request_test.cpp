@@ -2,6 +2,7 @@
 // bad requests in api/examples/bad/ with their expected first error, defaults,
 // error collection, hostile bodies and the canonical form.
 #include "api/render_request.h"
+#include "api/probe_request.h"
 
 #include <gtest/gtest.h>
 
@@ -304,6 +305,25 @@ TEST(RenderRequestDefaults, EarthClearHasNoAerosolUnlessGiven) {
   EXPECT_EQ(a.aerosol->optical_depth_550, 0.3);
   EXPECT_EQ(a.aerosol->asymmetry, 0.7);
   EXPECT_EQ(a.aerosol->phase, AerosolPhase::kCornetteShanks);
+}
+
+// "atmosphere.refraction": off by default and then absent from the canonical
+// text (every earlier request keeps its hash), written when on; the probe
+// reads it through the same atmosphere rules.
+TEST(RenderRequestDefaults, RefractionIsOffAndUnwrittenByDefault) {
+  const RenderRequest plain = parse_render_request(with(R"("atmosphere": {})"));
+  EXPECT_FALSE(plain.atmosphere.refraction);
+  EXPECT_EQ(canonical_text(plain).find("refraction"), std::string::npos);
+  const RenderRequest off = parse_render_request(with(R"("atmosphere": {"refraction": false})"));
+  EXPECT_EQ(canonical_text(off), canonical_text(plain));
+  const RenderRequest on = parse_render_request(with(R"("atmosphere": {"refraction": true})"));
+  EXPECT_TRUE(on.atmosphere.refraction);
+  EXPECT_NE(canonical_text(on).find(R"("refraction":true)"), std::string::npos);
+  EXPECT_TRUE(parse_render_request(canonical_text(on)).atmosphere.refraction) << "round trip";
+  EXPECT_TRUE(parse_probe_request(R"({"sun": {"zenith_deg": 90.5, "azimuth_deg": 0},
+      "atmosphere": {"refraction": true}, "directions": [{"zenith_deg": 90, "azimuth_deg": 0}],
+      "wavelengths_nm": [550]})")
+                  .atmosphere.refraction);
 }
 
 TEST(RenderRequestDefaults, NullMeansAbsentForFieldsWithoutADefaultValue) {

@@ -92,6 +92,17 @@ TEST(TimelapseRequest, FrameRequestsCarryTheirTimeAndSeed) {
   EXPECT_NE(canonical_text(same.frame_request(0)), canonical_text(same.frame_request(1)));
 }
 
+// "atmosphere.refraction" reaches every frame, and its canonical text.
+TEST(TimelapseRequest, FramesCarryRefraction) {
+  const TimelapseRequest r = parse_timelapse_request(body(
+      R"("start": "2013-05-27T20:00:00-04:00", "end": "2013-05-27T20:30:00-04:00", "frames": 2, )"
+      R"("atmosphere": {"refraction": true})"));
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_TRUE(r.frame_request(i).atmosphere.refraction);
+    EXPECT_NE(canonical_text(r.frame_request(i)).find(R"("refraction":true)"), std::string::npos);
+  }
+}
+
 TEST(TimelapseRequest, DefaultsAndOptions) {
   const std::string range = R"("start": "2013-05-27T19:00:00Z", "end": "2013-05-27T19:10:00Z", "frames": 3)";
   const TimelapseRequest d = parse_timelapse_request(body(range));

@@ -224,6 +224,7 @@ TEST_F(SkyHttpTest, BadParametersAre400NamingTheParameter) {
   expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=cube", "layout");
   expect_bad("/v1/sky/envmap.exr?" + sun + "&layout=equal_area&width=8192", "width");  // 4096 at most
   expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&layout=equal_area", "layout");  // envmap only
+  expect_bad("/v1/sky?" + sun + "&view_zenith=0&view_azimuth=0&refraction=yes", "refraction");
   // Every error at once, each by its name.
   auto r = client().Get("/v1/sky?lat=95&view_azimuth=400&foo=1");
   ASSERT_TRUE(r);
@@ -480,6 +481,20 @@ TEST(SkyQuery, DefaultsAndCanonicalForm) {
 
 // color_space and units: the defaults stay out of the canonical parameters
 // (the maps of before keep their cache key and ETag); others are in them.
+// refraction=true reaches the table's atmosphere (LutSky::refracted) and its
+// key; left out or false, the key is as it always was.
+TEST(SkyQuery, RefractionIsInTheKeyOnlyWhenOn) {
+  const SkyQuery plain = parse_sky_query({{"sun_zenith", "90.5"}, {"sun_azimuth", "0"}}, SkyRoute::kEnvmap);
+  const SkyQuery off =
+      parse_sky_query({{"sun_zenith", "90.5"}, {"sun_azimuth", "0"}, {"refraction", "false"}}, SkyRoute::kEnvmap);
+  const SkyQuery on =
+      parse_sky_query({{"sun_zenith", "90.5"}, {"sun_azimuth", "0"}, {"refraction", "true"}}, SkyRoute::kEnvmap);
+  EXPECT_FALSE(plain.atmosphere.refraction);
+  EXPECT_EQ(plain.canonical_json(SkyRoute::kEnvmap), off.canonical_json(SkyRoute::kEnvmap));
+  EXPECT_TRUE(on.atmosphere.refraction);
+  EXPECT_EQ(on.canonical_json(SkyRoute::kEnvmap)["atmosphere"]["refraction"], true);
+}
+
 TEST(SkyQuery, ColorSpaceAndUnitsAreInTheKeyOnlyWhenAsked) {
   const SkyQuery plain = parse_sky_query({{"sun_zenith", "45"}, {"sun_azimuth", "0"}}, SkyRoute::kEnvmap);
   const SkyQuery defaults = parse_sky_query(

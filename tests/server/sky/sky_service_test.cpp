@@ -343,6 +343,43 @@ MapIntegrals equal_area_integrals(const Image& image) {
   return m;
 }
 
+// With refraction the splatted disk of the sun at geometric zenith 90 deg
+// shows lifted by ~28' (one 0.35-degree pixel row or two at width 1024) and
+// carries its flattened solid angle: its energy is the straight disk's
+// times ~0.86 (the flattening) and the transmittance along the apparent
+// rays (the disk is lifted out of the densest air: more than the straight
+// disk at the horizon, whose lower half the planet hides).
+TEST(SkyServiceEnvmap, RefractedDiskIsLiftedAndKeepsFiniteEnergy) {
+  SkyTableParams straight = params(90.0, 90.0), refracted = params(90.0, 90.0);
+  refracted.atmosphere.refraction = true;
+  const int width = 1024;
+  CameraSpec spec;
+  spec.width = width;
+  spec.height = width / 2;
+  const Camera camera(spec, glm::dvec3(0.0));
+  double rows[2] = {0.0, 0.0}, energies[2] = {0.0, 0.0};
+  int k = 0;
+  for (const auto* p : {&straight, &refracted}) {
+    const auto table = build_sky_table(*p);
+    const Image with = render_envmap(*table, width, EnvmapSun::kDisk, 2);
+    const Image without = render_envmap(*table, width, EnvmapSun::kNone, 2);
+    double weight = 0.0, row = 0.0;
+    for (int y = 0; y < with.height(); ++y)
+      for (int x = 0; x < width; ++x) {
+        const double e = (with.luminance(x, y) - without.luminance(x, y)) * camera.pixel_solid_angle(x, y);
+        ASSERT_TRUE(std::isfinite(e));
+        weight += std::max(0.0, e);
+        row += std::max(0.0, e) * (y + 0.5);
+      }
+    rows[k] = row / weight;
+    energies[k] = weight;
+    ++k;
+  }
+  const double pixel_deg = 180.0 / (width / 2);
+  EXPECT_NEAR((rows[0] - rows[1]) * pixel_deg * 60.0, 28.0, 12.0) << "lifted by the horizon refraction";
+  EXPECT_GT(energies[1], 0.0);
+}
+
 TEST(SkyServiceEnvmap, EqualAreaMapHoldsTheLatLongMapsFlux) {
   // Two independent discretisations of one sky: their integrals agree to
   // 0.5 %, the disk's energy is exact in both (1e-3, as above), and the
