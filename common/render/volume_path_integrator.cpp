@@ -938,6 +938,68 @@ bool VolumePathIntegrator::residual_tracking_pays(const glm::dvec3& p, const glm
          r - scene_.atmosphere().planet_radius_m() < options_.residual_tracking_below_altitude_m;
 }
 
+// Ratio tracking of a shadow ray's transmittance T_ray along a walk of its
+// shell segments, with the MIS ratios r_l (light sampling) and r_u
+// (unidirectional) of the null collisions, Russian roulette once the
+// MIS-weighted transmittance is small; all three end divided by the hero
+// wavelength's majorant transmittance.  False when T_ray is 0.
+template <class Walk, class Line>
+bool VolumePathIntegrator::ratio_track_shadow(Walk& walk, const Line& line, const Vertex& v, Sampler& sampler,
+                                              PathCounters* counters, SampledSpectrum* T_ray_out,
+                                              SampledSpectrum* r_l_out, SampledSpectrum* r_u_out) const {
+  SampledSpectrum& T_ray = *T_ray_out;
+  SampledSpectrum& r_l_ray = *r_l_out;
+  SampledSpectrum& r_u_ray = *r_u_out;
+  const AtmosphereMedium& medium = scene_.medium();
+  MediumPoint mp;
+  const SampledSpectrum T_maj = sample_t_maj_along(
+      walk, *v.shadow_majorants, medium, line, *v.path, sampler, mp,
+      [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
+        ++counters->collisions;
+        const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
+        const double pdf = T_maj_seg[0] * sigma_maj[0];
+        T_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+        r_l_ray *= T_maj_seg * sigma_maj * (1.0 / pdf);
+        r_u_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
+        // Russian roulette once the MIS-weighted transmittance is small.
+        const SampledSpectrum Tr = T_ray * (1.0 / (r_l_ray + r_u_ray).average());
+        if (Tr.max() < 0.05) {
+          const double q = 0.75;
+          if (sampler.next() < q)
+            T_ray = SampledSpectrum(0.0);
+          else
+            T_ray *= 1.0 / (1.0 - q);
+        }
+        return !T_ray.is_zero();
+      },
+      options_.shadow_majorant_scale);
+  if (T_ray.is_zero()) return false;
+  const double T0 = T_maj[0];
+  T_ray *= T_maj * (1.0 / T0);
+  r_l_ray *= T_maj * (1.0 / T0);
+  r_u_ray *= T_maj * (1.0 / T0);
+  return true;
+}
+
+// The sun's contribution through a shadow ray of transmittance T_ray: MIS of
+// sun sampling (pdf_light) against the phase function or BSDF (pdf_scatter),
+// the balance heuristic unless a surface asks otherwise.
+SampledSpectrum VolumePathIntegrator::weigh_sun(const Vertex& v, const SampledSpectrum& T_ray,
+                                                const SampledSpectrum& r_l_ray, const SampledSpectrum& r_u_ray,
+                                                double pdf_light, const SampledSpectrum& f,
+                                                const SampledSpectrum& pdf_scatter) const {
+  const Sun& sun = scene_.sun();
+  const SampledSpectrum& Le = v.path->sun_radiance;
+  const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
+  const SampledSpectrum Ld = v.beta * f * T_ray * Le;
+  if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
+    return Ld * (1.0 / r_l.average());
+  const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
+  if (v.surface && options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower)
+    return Ld * power_weight(r_l.average(), r_u.average());
+  return Ld * (1.0 / (r_l + r_u).average());
+}
+
 // Next-event estimation of the sun from a vertex (pbrt-v4 SampleLd, with
 // per-wavelength scattering pdfs because the mixture phase depends on l):
 //   L_d = beta f T L_sun / avg_i(r_p,i (pdf_light r_l,ray,i + pdf_scatter,i r_u,ray,i)),
@@ -1024,46 +1086,12 @@ SampledSpectrum VolumePathIntegrator::sample_sun(const Vertex& v, const SampledW
   } else if (top.hit && top.t_far > 0.0) {
     const AtmosphereMedium& medium = scene_.medium();
     const ShellMajorants& shells = medium.coarse_shells();
-    MediumPoint mp;
     ShellTraversal walk(shadow, radial, atmosphere.planet_radius_m(), shells.bottoms, std::max(0.0, top.t_near),
                         top.t_far);
-    const SampledSpectrum T_maj = sample_t_maj_along(
-        walk, *v.shadow_majorants, medium, shadow, *v.path, sampler, mp,
-        [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
-          ++counters->collisions;
-          const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
-          const double pdf = T_maj_seg[0] * sigma_maj[0];
-          T_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
-          r_l_ray *= T_maj_seg * sigma_maj * (1.0 / pdf);
-          r_u_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
-          // Russian roulette once the MIS-weighted transmittance is small.
-          const SampledSpectrum Tr = T_ray * (1.0 / (r_l_ray + r_u_ray).average());
-          if (Tr.max() < 0.05) {
-            const double q = 0.75;
-            if (sampler.next() < q)
-              T_ray = SampledSpectrum(0.0);
-            else
-              T_ray *= 1.0 / (1.0 - q);
-          }
-          return !T_ray.is_zero();
-        },
-        options_.shadow_majorant_scale);
-    if (T_ray.is_zero()) return SampledSpectrum(0.0);
-    const double T0 = T_maj[0];
-    T_ray *= T_maj * (1.0 / T0);
-    r_l_ray *= T_maj * (1.0 / T0);
-    r_u_ray *= T_maj * (1.0 / T0);
+    if (!ratio_track_shadow(walk, shadow, v, sampler, counters, &T_ray, &r_l_ray, &r_u_ray)) return SampledSpectrum(0.0);
   }
 
-  const SampledSpectrum& Le = v.path->sun_radiance;
-  const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
-  const SampledSpectrum Ld = v.beta * f * T_ray * Le;
-  if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
-    return Ld * (1.0 / r_l.average());
-  const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
-  if (v.surface && options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower)
-    return Ld * power_weight(r_l.average(), r_u.average());
-  return Ld * (1.0 / (r_l + r_u).average());
+  return weigh_sun(v, T_ray, r_l_ray, r_u_ray, pdf_light, f, pdf_scatter);
 }
 
 // The bent shadow ray of sample_sun towards the apparent direction wi.
@@ -1071,7 +1099,6 @@ SampledSpectrum VolumePathIntegrator::sample_sun_bent(const Vertex& v, const glm
                                                       const SampledSpectrum& f, const SampledSpectrum& pdf_scatter,
                                                       const SampledWavelengths& lambda, Sampler& sampler,
                                                       PathCounters* counters) const {
-  const Sun& sun = scene_.sun();
   const AtmosphereMedium& medium = scene_.medium();
   thread_local BentPath path;
   scene_.refraction()->trace(v.p, wi, lambda.lambda_nm[0], &path);
@@ -1088,45 +1115,11 @@ SampledSpectrum VolumePathIntegrator::sample_sun_bent(const Vertex& v, const glm
   }
   SampledSpectrum T_ray(T_clouds), r_u_ray(1.0), r_l_ray(1.0);
   if (path.in_atmosphere) {
-    MediumPoint mp;
     BentShellWalk walk(path, scene_.atmosphere().planet_radius_m(), medium.coarse_shells().bottoms, path.t_enter,
                        path.t_end);
-    const SampledSpectrum T_maj = sample_t_maj_along(
-        walk, *v.shadow_majorants, medium, walk, *v.path, sampler, mp,
-        [&](double, const glm::dvec3&, const SampledSpectrum& sigma_maj, const SampledSpectrum& T_maj_seg) {
-          ++counters->collisions;
-          const SampledSpectrum sigma_n = clamp_zero(sigma_maj - mp.sigma_a - mp.sigma_s);
-          const double pdf = T_maj_seg[0] * sigma_maj[0];
-          T_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
-          r_l_ray *= T_maj_seg * sigma_maj * (1.0 / pdf);
-          r_u_ray *= T_maj_seg * sigma_n * (1.0 / pdf);
-          // Russian roulette once the MIS-weighted transmittance is small.
-          const SampledSpectrum Tr = T_ray * (1.0 / (r_l_ray + r_u_ray).average());
-          if (Tr.max() < 0.05) {
-            const double q = 0.75;
-            if (sampler.next() < q)
-              T_ray = SampledSpectrum(0.0);
-            else
-              T_ray *= 1.0 / (1.0 - q);
-          }
-          return !T_ray.is_zero();
-        },
-        options_.shadow_majorant_scale);
-    if (T_ray.is_zero()) return SampledSpectrum(0.0);
-    const double T0 = T_maj[0];
-    T_ray *= T_maj * (1.0 / T0);
-    r_l_ray *= T_maj * (1.0 / T0);
-    r_u_ray *= T_maj * (1.0 / T0);
+    if (!ratio_track_shadow(walk, walk, v, sampler, counters, &T_ray, &r_l_ray, &r_u_ray)) return SampledSpectrum(0.0);
   }
-  const SampledSpectrum& Le = v.path->sun_radiance;
-  const SampledSpectrum r_l = v.r_p * r_l_ray * pdf_light;
-  const SampledSpectrum Ld = v.beta * f * T_ray * Le;
-  if (sun.is_point() || (v.surface && options_.surface_sun_sampling == SurfaceSunSampling::kSunOnly))
-    return Ld * (1.0 / r_l.average());
-  const SampledSpectrum r_u = v.r_p * r_u_ray * pdf_scatter;
-  if (v.surface && options_.surface_mis_heuristic == SurfaceMisHeuristic::kPower)
-    return Ld * power_weight(r_l.average(), r_u.average());
-  return Ld * (1.0 / (r_l + r_u).average());
+  return weigh_sun(v, T_ray, r_l_ray, r_u_ray, pdf_light, f, pdf_scatter);
 }
 
 // Single scattering of sunlight along a segment, sampled where the sun is

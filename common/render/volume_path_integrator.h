@@ -334,6 +334,13 @@ class VolumePathIntegrator {
                                   const SampledSpectrum& pdf_scatter, const SampledWavelengths& lambda,
                                   Sampler& sampler, PathCounters* counters) const;
 
+  template <class Walk, class Line>
+  bool ratio_track_shadow(Walk& walk, const Line& line, const Vertex& v, Sampler& sampler, PathCounters* counters,
+                          SampledSpectrum* T_ray, SampledSpectrum* r_l_ray, SampledSpectrum* r_u_ray) const;
+  SampledSpectrum weigh_sun(const Vertex& v, const SampledSpectrum& T_ray, const SampledSpectrum& r_l_ray,
+                            const SampledSpectrum& r_u_ray, double pdf_light, const SampledSpectrum& f,
+                            const SampledSpectrum& pdf_scatter) const;
+
   const Scene& scene_;
   IntegratorOptions options_;
 };
