@@ -141,6 +141,12 @@ std::optional<RefractedView::Apparent> LutSky::disk_sample_direction(const glm::
   return refraction_->apparent_direction(d, 550.0);
 }
 
+bool LutSky::sees_sun_disk(const glm::dvec3& v) const {
+  if (!refraction_) return sun_->contains(v);
+  const auto seen = refraction_->true_direction(v, 550.0);
+  return seen && sun_->contains(*seen);
+}
+
 LutSky LutSky::refracted() const {
   LutSky sky = *this;
   if (!above_)

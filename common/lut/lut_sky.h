@@ -139,6 +139,10 @@ class LutSky {
   // the disk samples the true disk and puts each sample there, its solid
   // angle times the ratio.  nullopt where the planet hides it.
   std::optional<RefractedView::Apparent> disk_sample_direction(const glm::dvec3& d) const;
+  // Whether the view v (unit, observer frame) looks at the sun's disk: the
+  // disk itself without refraction, the apparent (lifted, flattened) disk at
+  // 550 nm with it.
+  bool sees_sun_disk(const glm::dvec3& v) const;
 
   const SpectralGrid& grid() const;
   // E_sun and the disk's radiance per bin (bin means).

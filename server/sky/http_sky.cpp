@@ -415,7 +415,7 @@ void SkyHttp::lookup(const httplib::Request& req, httplib::Response& res) const 
                        {"view",
                         {{"zenith_deg", q.view_zenith_deg},
                          {"azimuth_deg", api::canonical_azimuth(q.view_azimuth_deg)}}},
-                       {"in_sun_disk", table->sun.contains(glm::normalize(dir))},
+                       {"in_sun_disk", table->sky.sees_sun_disk(glm::normalize(dir))},
                        {"altitude_m", q.location.altitude_m}};
   std::string body = dump_json(answer);
   if (not_modified(req, res, quoted_text(text_hash(body)), cache_control_)) return;

@@ -187,6 +187,25 @@ TEST_F(SkyHttpTest, ConcurrentIdenticalRequestsBuildTheTableOnce) {
   EXPECT_EQ(s.table_hits + s.table_waits, static_cast<std::uint64_t>(kThreads - 1));
 }
 
+// With refraction=true the sun at geometric zenith 90.3 deg is lifted above
+// the horizon (by ~30', docs/physics.md "Refraction"): a view 0.5 deg above
+// its true place looks at its disk, and the answer says so and carries the
+// disk's light; without refraction the same view sees the sky beside a sun
+// below the horizon.
+TEST_F(SkyHttpTest, RefractionLiftsTheSunIntoTheLookedUpView) {
+  start();
+  const std::string q = "/v1/sky?lat=42.44&lon=-76.5&sun_zenith=90.3&sun_azimuth=300&view_zenith=89.8&view_azimuth=300";
+  auto on = client().Get(q + "&refraction=true");
+  auto off = client().Get(q);
+  ASSERT_TRUE(on && off);
+  ASSERT_EQ(on->status, 200) << on->body;
+  ASSERT_EQ(off->status, 200) << off->body;
+  const auto a = json_of(on), b = json_of(off);
+  EXPECT_TRUE(a["in_sun_disk"].get<bool>());
+  EXPECT_FALSE(b["in_sun_disk"].get<bool>());
+  EXPECT_GT(a["luminance_cd_m2"].get<double>(), 100.0 * b["luminance_cd_m2"].get<double>());
+}
+
 TEST_F(SkyHttpTest, BadParametersAre400NamingTheParameter) {
   start();
   const std::string sun = "sun_zenith=30&sun_azimuth=180";
