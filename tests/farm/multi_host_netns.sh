@@ -34,7 +34,12 @@ cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
   sleep 0.3
   for p in "${pids[@]}"; do kill -9 "$p" 2>/dev/null || true; done
-  for h in "${hosts[@]}" hub; do ip netns del "$tag$h" 2>/dev/null || true; done
+  # A pid above is the subshell of in_ns, not always the program it runs:
+  # whatever still runs in a namespace goes with it.
+  for h in "${hosts[@]}" hub; do
+    ip netns pids "$tag$h" 2>/dev/null | xargs -r kill -9 2>/dev/null || true
+    ip netns del "$tag$h" 2>/dev/null || true
+  done
   if [[ $rc -ne 0 ]]; then
     for f in "$work"/*.log; do [[ -f $f ]] && { echo "--- $f"; tail -n 30 "$f"; }; done
   fi
